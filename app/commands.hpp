@@ -1,0 +1,36 @@
+#pragma once
+// The front end's commands, each a plain options struct and a function; main.cpp parses the
+// command line (CLI11 stays in that one file) and maps exceptions to exit statuses.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace app {
+
+std::string version_text();
+
+struct SdfCommand {
+  std::filesystem::path mesh;
+  std::filesystem::path output;
+  std::string units = "mm";
+  std::string role = "cavity";
+  std::optional<double> voxel_mm;
+  double grain_radius_mm = 0.5;
+  double skin_mm = 0.25;
+  std::optional<double> tolerance_mm;
+  std::optional<double> max_hole_mm;
+  double table_margin_mm = 10.0;
+  std::size_t verify = 0;
+  std::uint64_t seed = 1;
+};
+int run_sdf(const SdfCommand& command);
+
+struct DieCommand {
+  std::string name;  // bundled die
+  std::filesystem::path output;
+};
+int run_die(const DieCommand& command);
+
+}  // namespace app

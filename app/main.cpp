@@ -1,0 +1,64 @@
+// diefill's command line. Parsing only: each command lives in its own file (commands.hpp).
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include "app/commands.hpp"
+#include "core/error.hpp"
+
+namespace {
+
+void add_sdf(CLI::App& root, app::SdfCommand& c, std::function<int()>& action) {
+  CLI::App* cmd = root.add_subcommand("sdf", "Check and repair a mesh, then write its signed-distance grid");
+  cmd->add_option("MESH", c.mesh, "Mesh file (STL, OBJ, PLY, OFF, ...)")->required();
+  cmd->add_option("-o,--output", c.output, "Output .vdb file");
+  cmd->add_option("--voxel", c.voxel_mm, "Voxel edge [mm] (default: a quarter of the grain radius)");
+  cmd->add_option("--units", c.units, "Length unit of the file: mm, m or in")->capture_default_str();
+  cmd->add_option("--role", c.role, "cavity (the part, open at the table) or tool (the die body)")
+      ->capture_default_str();
+  cmd->add_option("--grain-radius", c.grain_radius_mm, "Largest grain radius [mm]")->capture_default_str();
+  cmd->add_option("--skin", c.skin_mm, "Neighbour skin [mm]")->capture_default_str();
+  cmd->add_option("--tolerance", c.tolerance_mm, "Largest change repair may make [mm] (default: half a voxel)");
+  cmd->add_option("--max-hole", c.max_hole_mm, "Largest hole repair fills [mm] (default: 10 voxels)");
+  cmd->add_option("--table-margin", c.table_margin_mm, "Die table beyond the cavity [mm]")->capture_default_str();
+  cmd->add_option("--verify", c.verify, "Compare N points in the band with the exact distance");
+  cmd->add_option("--seed", c.seed, "Seed of the verification points")->capture_default_str();
+  cmd->callback([&] { action = [&] { return app::run_sdf(c); }; });
+}
+
+void add_die(CLI::App& root, app::DieCommand& c, std::function<int()>& action) {
+  CLI::App* cmd = root.add_subcommand("die", "Write a bundled die mesh (ring, disc) as binary STL in mm");
+  cmd->add_option("NAME", c.name, "ring or disc")->required();
+  cmd->add_option("-o,--output", c.output, "Output STL")->required();
+  cmd->callback([&] { action = [&] { return app::run_die(c); }; });
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App root{"diefill: simulate how a powder fills a press die"};
+  root.set_version_flag("--version", [] { return app::version_text(); });
+  root.require_subcommand(1);
+  std::function<int()> action;
+  app::SdfCommand sdf;
+  app::DieCommand die;
+  add_sdf(root, sdf, action);
+  add_die(root, die, action);
+  try {
+    root.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int status = root.exit(e);
+    return status == 0 ? 0 : diefill::exit_bad_input;
+  }
+  try {
+    return action ? action() : diefill::exit_ok;
+  } catch (const diefill::InputError& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return diefill::exit_bad_input;
+  } catch (const diefill::StabilityError& e) {
+    fmt::print(stderr, "stopped: {}\n", e.what());
+    return diefill::exit_unstable;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return diefill::exit_other;
+  }
+}

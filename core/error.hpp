@@ -1,0 +1,30 @@
+#pragma once
+// Errors by phase (STYLE.md §8): configuration and input problems throw a typed exception that
+// names the file, the field and what to do; the front end maps the type to an exit status.
+#include <stdexcept>
+#include <string>
+
+namespace diefill {
+
+// Bad input: exit status 2. `file` is the path the user gave (or empty), `field` the key,
+// option or mesh property at fault, `remedy` what the user should do about it.
+class InputError : public std::runtime_error {
+ public:
+  InputError(std::string file, std::string field, const std::string& problem, std::string remedy);
+  const std::string& file() const { return file_; }
+  const std::string& field() const { return field_; }
+  const std::string& remedy() const { return remedy_; }
+
+ private:
+  std::string file_, field_, remedy_;
+};
+
+// The simulation stopped on a stability check: exit status 3.
+class StabilityError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum ExitStatus : int { exit_ok = 0, exit_other = 1, exit_bad_input = 2, exit_unstable = 3 };
+
+}  // namespace diefill

@@ -1,0 +1,1 @@
+// The DEM core arrives with issue 3.

@@ -1,0 +1,228 @@
+#include "mesh/die.hpp"
+
+#include <fmt/core.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/sha256.hpp"
+
+namespace mesh {
+
+namespace fs = std::filesystem;
+using diefill::InputError;
+using nlohmann::json;
+
+namespace {
+
+// Bumped whenever the mesh stage's output for the same inputs changes.
+constexpr int cache_format = 1;
+
+json report_json(const MeshReport& r) {
+  return {{"triangles", r.triangles},
+          {"vertices", r.vertices},
+          {"boundary_edges", r.boundary_edges},
+          {"non_manifold_edges", r.non_manifold_edges},
+          {"inconsistent_edges", r.inconsistent_edges},
+          {"degenerate_faces", r.degenerate_faces},
+          {"duplicate_faces", r.duplicate_faces},
+          {"self_intersections", r.self_intersections},
+          {"shells", r.shells},
+          {"closed", r.closed},
+          {"orientation", r.orientation},
+          {"volume_m3", r.volume_m3},
+          {"area_m2", r.area_m2},
+          {"bbox_min_m", {r.bbox.lo.x(), r.bbox.lo.y(), r.bbox.lo.z()}},
+          {"bbox_max_m", {r.bbox.hi.x(), r.bbox.hi.y(), r.bbox.hi.z()}}};
+}
+
+MeshReport report_from_json(const json& j) {
+  MeshReport r;
+  r.triangles = j.at("triangles");
+  r.vertices = j.at("vertices");
+  r.boundary_edges = j.at("boundary_edges");
+  r.non_manifold_edges = j.at("non_manifold_edges");
+  r.inconsistent_edges = j.at("inconsistent_edges");
+  r.degenerate_faces = j.at("degenerate_faces");
+  r.duplicate_faces = j.at("duplicate_faces");
+  r.self_intersections = j.at("self_intersections");
+  r.shells = j.at("shells");
+  r.closed = j.at("closed");
+  r.orientation = j.at("orientation");
+  r.volume_m3 = j.at("volume_m3");
+  r.area_m2 = j.at("area_m2");
+  for (int d = 0; d < 3; ++d) {
+    r.bbox.lo[d] = j.at("bbox_min_m")[d];
+    r.bbox.hi[d] = j.at("bbox_max_m")[d];
+  }
+  return r;
+}
+
+// Meshes in the cache are raw doubles and int32 indices: exact, and fast to read back.
+void write_mesh_binary(const TriMesh& m, const fs::path& path) {
+  std::string bytes;
+  const std::uint64_t nv = m.vertices.size(), nt = m.triangles.size();
+  bytes.append(reinterpret_cast<const char*>(&nv), 8);
+  bytes.append(reinterpret_cast<const char*>(&nt), 8);
+  for (const Vec3& v : m.vertices) bytes.append(reinterpret_cast<const char*>(v.data()), 24);
+  for (const Triangle& t : m.triangles) bytes.append(reinterpret_cast<const char*>(t.data()), 12);
+  diefill::write_file_atomic(path, bytes);
+}
+
+std::optional<TriMesh> read_mesh_binary(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::uint64_t nv = 0, nt = 0;
+  if (!in.read(reinterpret_cast<char*>(&nv), 8) || !in.read(reinterpret_cast<char*>(&nt), 8))
+    return std::nullopt;
+  TriMesh m;
+  m.vertices.resize(nv);
+  m.triangles.resize(nt);
+  for (Vec3& v : m.vertices) in.read(reinterpret_cast<char*>(v.data()), 24);
+  for (Triangle& t : m.triangles) in.read(reinterpret_cast<char*>(t.data()), 12);
+  if (!in) return std::nullopt;
+  return m;
+}
+
+void check_options(const DieOptions& o, const std::string& source) {
+  auto positive = [&](double v, const char* field) {
+    if (!(v > 0) || !std::isfinite(v))
+      throw InputError(source, field, fmt::format("must be a positive length, got {}", v),
+                       "Give a positive value");
+  };
+  positive(o.voxel_m, "voxel");
+  positive(o.exterior_band_m, "exterior band");
+  positive(o.interior_band_m, "interior band");
+  positive(o.repair.tolerance_m, "tolerance");
+  positive(o.table_margin_m, "table margin");
+}
+
+}  // namespace
+
+WallRole parse_role(std::string_view text, std::string_view field) {
+  if (text == "cavity") return WallRole::cavity;
+  if (text == "tool" || text == "solid") return WallRole::tool;
+  throw InputError("", std::string(field), "unknown role '" + std::string(text) + "'",
+                   "Use cavity (the part's shape, open at the table) or tool (the die body)");
+}
+
+std::string_view role_name(WallRole role) { return role == WallRole::cavity ? "cavity" : "tool"; }
+
+DieOptions die_options_for_grains(double grain_radius_m, double skin_m, std::optional<double> voxel_m) {
+  DieOptions o;
+  o.voxel_m = voxel_m ? *voxel_m : default_voxel_fraction * grain_radius_m;
+  o.exterior_band_m = grain_radius_m + skin_m + o.voxel_m;
+  o.interior_band_m = 2.0 * o.voxel_m;
+  o.repair.tolerance_m = 0.5 * o.voxel_m;
+  o.repair.max_hole_m = 10.0 * o.voxel_m;
+  return o;
+}
+
+std::string die_cache_key(const std::string& file_sha256, const DieOptions& o) {
+  std::string text = fmt::format(
+      "format={};sha={};unit={};role={};voxel={:.17g};ext={:.17g};int={:.17g};tol={:.17g};"
+      "hole={:.17g};wrap={};margin={:.17g}",
+      cache_format, file_sha256, unit_name(o.unit), role_name(o.role), o.voxel_m, o.exterior_band_m,
+      o.interior_band_m, o.repair.tolerance_m, o.repair.max_hole_m, o.repair.allow_wrap,
+      o.table_margin_m);
+  if (o.table)
+    text += fmt::format(";table={:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", o.table->x_min,
+                        o.table->y_min, o.table->x_max, o.table->y_max, o.table->thickness);
+  return diefill::sha256_hex(text);
+}
+
+PreparedDie prepare_die(const fs::path& path, const DieOptions& options,
+                        const std::optional<fs::path>& cache_dir) {
+  const std::string source = path.string();
+  check_options(options, source);
+  PreparedDie out;
+  out.source = source;
+  out.name = path.stem().string();
+
+  // Import first: it gives the clear message for a missing, empty or unreadable file.
+  ImportResult imported = import_mesh(path, {options.unit});
+  out.sha256 = diefill::sha256_file(path);
+  out.cache_key = die_cache_key(out.sha256, options);
+
+  if (cache_dir) {
+    const fs::path base = *cache_dir / out.cache_key;
+    std::ifstream meta_in(base.string() + ".json");
+    if (meta_in) {
+      try {
+        const json meta = json::parse(meta_in);
+        auto cavity = read_mesh_binary(base.string() + ".cavity.bin");
+        auto solid = read_mesh_binary(base.string() + ".solid.bin");
+        if (cavity && solid && meta.at("key") == out.cache_key) {
+          out.before = report_from_json(meta.at("before"));
+          out.after = report_from_json(meta.at("after"));
+          out.actions = meta.at("actions").get<std::vector<std::string>>();
+          out.wrapped = meta.at("wrapped");
+          out.hausdorff_m = meta.at("hausdorff_m");
+          out.table_z = meta.at("table_z");
+          out.cavity = std::move(*cavity);
+          out.solid = std::move(*solid);
+          out.sdf = SdfGrid::read(base.string() + ".vdb");
+          out.sdf_from_cache = true;
+          return out;
+        }
+      } catch (const std::exception& e) {
+        diefill::log::warn("ignoring a broken cache entry {}: {}", base.string(), e.what());
+      }
+    }
+  }
+
+  RepairResult repaired = repair(imported.mesh, options.repair, source);
+  out.before = repaired.before;
+  out.after = repaired.after;
+  out.actions = repaired.actions;
+  out.wrapped = repaired.wrapped;
+  out.hausdorff_m = repaired.hausdorff_m;
+  out.cavity = std::move(repaired.mesh);
+
+  const double extent = out.after.bbox.size().maxCoeff();
+  if (extent < 4 * options.voxel_m)
+    throw InputError(source, "units",
+                     fmt::format("the die is only {:.4g} mm across, less than 4 voxels of {:.4g} mm "
+                                 "(read as {})",
+                                 extent * 1e3, options.voxel_m * 1e3, unit_name(options.unit)),
+                     "If the file is in metres or inches, declare it (--units m, --units in, or "
+                     "units = \"m\" in the scene); otherwise choose a smaller voxel");
+
+  if (options.role == WallRole::cavity) {
+    const TableExtent table = options.table ? *options.table : table_around(out.cavity, options.table_margin_m);
+    ToolMesh tool = tool_from_cavity(out.cavity, table, source);
+    out.solid = std::move(tool.mesh);
+    out.table_z = tool.table_z;
+  } else {
+    out.solid = out.cavity;
+    out.table_z = out.after.bbox.hi.z();
+  }
+
+  out.sdf = build_sdf(out.solid, {options.voxel_m, options.exterior_band_m, options.interior_band_m});
+  out.sdf.set_metadata("role", std::string(role_name(options.role)));
+  out.sdf.set_metadata("source_sha256", out.sha256);
+  out.sdf.set_metadata("source", path.filename().string());
+  out.sdf.set_metadata("table_z_m", fmt::format("{:.17g}", out.table_z));
+
+  if (cache_dir) {
+    const fs::path base = *cache_dir / out.cache_key;
+    write_mesh_binary(out.cavity, base.string() + ".cavity.bin");
+    write_mesh_binary(out.solid, base.string() + ".solid.bin");
+    out.sdf.write(base.string() + ".vdb");
+    // The JSON is written last: an entry counts only once all its files are complete.
+    const json meta = {{"key", out.cache_key},
+                       {"source", source},
+                       {"before", report_json(out.before)},
+                       {"after", report_json(out.after)},
+                       {"actions", out.actions},
+                       {"wrapped", out.wrapped},
+                       {"hausdorff_m", out.hausdorff_m},
+                       {"table_z", out.table_z}};
+    diefill::write_file_atomic(base.string() + ".json", meta.dump(2));
+  }
+  return out;
+}
+
+}  // namespace mesh

@@ -1,0 +1,67 @@
+#pragma once
+// The mesh stage for one die, as the pipeline and `diefill sdf` run it: import, check and
+// repair, build the solid the powder meets (the tool around a cavity, or the mesh itself), and
+// its signed-distance field, cached by content hash and parameters.
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "mesh/import.hpp"
+#include "mesh/repair.hpp"
+#include "mesh/sdf.hpp"
+#include "mesh/tool.hpp"
+
+namespace mesh {
+
+enum class WallRole { cavity, tool };
+WallRole parse_role(std::string_view text, std::string_view field);
+std::string_view role_name(WallRole role);
+
+// Voxel edge as a fraction of the smallest grain radius. Trilinear interpolation of an exact
+// distance field is exact on flat faces; on the ring's Ø10 mm core its error is h²/(8R) [m],
+// and a grain's overlap is about 1 % of its radius: at h = R/4 for R = 0.5 mm the curvature
+// error is 0.8 µm, a sixth of that overlap (see tests/test_sdf.cpp for the measured values).
+inline constexpr double default_voxel_fraction = 0.25;
+
+struct DieOptions {
+  LengthUnit unit = LengthUnit::mm;
+  WallRole role = WallRole::cavity;
+  double voxel_m = 1.25e-4;         // voxel edge [m]
+  double exterior_band_m = 1e-3;    // contact range plus neighbour skin plus one voxel [m]
+  double interior_band_m = 2.5e-4;  // [m]
+  RepairOptions repair;
+  std::optional<TableExtent> table;  // cavity role: defaults to table_around(cavity, margin)
+  double table_margin_m = 10e-3;
+};
+
+struct PreparedDie {
+  std::string name;    // file stem
+  std::string source;  // path as given
+  std::string sha256;  // of the file's bytes
+  MeshReport before, after;          // checks before and after repair
+  std::vector<std::string> actions;  // repair steps taken
+  bool wrapped = false;
+  double hausdorff_m = 0.0;
+  TriMesh cavity;      // repaired mesh as given (the cavity, or the tool for role = tool) [m]
+  TriMesh solid;       // what the powder meets: tool for role = cavity, else the mesh itself
+  double table_z = 0.0;
+  SdfGrid sdf;
+  bool sdf_from_cache = false;
+  std::string cache_key;
+};
+
+// Throws InputError for every defect of the file or the options (a die smaller than a few
+// voxels, for instance, usually a mesh in metres read as millimetres).
+PreparedDie prepare_die(const std::filesystem::path& path, const DieOptions& options,
+                        const std::optional<std::filesystem::path>& cache_dir);
+
+// Voxel and band for grains of largest radius R and neighbour skin s: the voxel is
+// `voxel_fraction` R unless given; the band reaches R + s + one voxel outside the solid (the
+// farthest a grain centre can be and still need the wall) and two voxels inside.
+DieOptions die_options_for_grains(double grain_radius_m, double skin_m,
+                                  std::optional<double> voxel_m = std::nullopt);
+
+// The cache key: the file's bytes and every parameter that changes the result.
+std::string die_cache_key(const std::string& file_sha256, const DieOptions& options);
+
+}  // namespace mesh

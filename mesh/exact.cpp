@@ -1,0 +1,134 @@
+// The only translation unit that includes Embree.
+#include "mesh/exact.hpp"
+
+#include <embree3/rtcore.h>
+
+#include <cmath>
+#include <limits>
+
+#include "mesh/geometry.hpp"
+#include "mesh/versions.hpp"
+
+namespace mesh {
+
+struct ExactSurface::Impl {
+  TriMesh mesh;   // double precision copy: distances are computed from it, not from floats
+  Vec3 centre;    // Embree's float buffers hold coordinates relative to it
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+
+  struct Query {
+    const Impl* self;
+    Vec3 point;
+    Vec3 closest;
+    double distance;
+  };
+
+  static bool closest_callback(RTCPointQueryFunctionArguments* args) {
+    auto* q = static_cast<Query*>(args->userPtr);
+    const TriMesh& m = q->self->mesh;
+    const Triangle& t = m.triangles[args->primID];
+    const Vec3 c = closest_point_on_triangle(q->point, m.vertices[t[0]], m.vertices[t[1]],
+                                             m.vertices[t[2]]);
+    const double d = (c - q->point).norm();
+    if (d < q->distance) {
+      q->distance = d;
+      q->closest = c;
+      // Slightly larger than d: Embree's float bounds must not cull the true closest triangle.
+      args->query->radius = float(d * (1.0 + 1e-5) + 1e-12);
+      return true;
+    }
+    return false;
+  }
+
+  int crossings(const Vec3& origin, const Vec3& direction) const {
+    int count = 0;
+    float tnear = 0.0f;
+    const Vec3 o = origin - centre;
+    for (int guard = 0; guard < 100000; ++guard) {
+      RTCRayHit rh{};
+      rh.ray.org_x = float(o.x());
+      rh.ray.org_y = float(o.y());
+      rh.ray.org_z = float(o.z());
+      rh.ray.dir_x = float(direction.x());
+      rh.ray.dir_y = float(direction.y());
+      rh.ray.dir_z = float(direction.z());
+      rh.ray.tnear = tnear;
+      rh.ray.tfar = std::numeric_limits<float>::infinity();
+      rh.ray.mask = 0xFFFFFFFFu;
+      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      RTCIntersectContext context;
+      rtcInitIntersectContext(&context);
+      rtcIntersect1(scene, &context, &rh);
+      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
+      ++count;
+      tnear = std::nextafter(rh.ray.tfar, std::numeric_limits<float>::infinity()) +
+              1e-7f * std::max(1.0f, rh.ray.tfar);
+    }
+    return count;
+  }
+};
+
+ExactSurface::ExactSurface(const TriMesh& mesh) : impl_(std::make_unique<Impl>()) {
+  Impl& s = *impl_;
+  s.mesh = mesh;
+  const Box box = bounding_box(mesh);
+  s.centre = box.empty() ? Vec3::Zero() : Vec3((box.lo + box.hi) / 2);
+  s.device = rtcNewDevice("threads=1");
+  s.scene = rtcNewScene(s.device);
+  rtcSetSceneBuildQuality(s.scene, RTC_BUILD_QUALITY_HIGH);
+  RTCGeometry geometry = rtcNewGeometry(s.device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+      geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.vertices.size()));
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
+    for (int d = 0; d < 3; ++d) vertices[3 * i + d] = float(mesh.vertices[i][d] - s.centre[d]);
+  auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+      geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), mesh.triangles.size()));
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
+    for (int d = 0; d < 3; ++d) indices[3 * i + d] = unsigned(mesh.triangles[i][d]);
+  rtcSetGeometryPointQueryFunction(geometry, &Impl::closest_callback);
+  rtcCommitGeometry(geometry);
+  rtcAttachGeometry(s.scene, geometry);
+  rtcReleaseGeometry(geometry);
+  rtcCommitScene(s.scene);
+}
+
+ExactSurface::~ExactSurface() {
+  if (impl_) {
+    rtcReleaseScene(impl_->scene);
+    rtcReleaseDevice(impl_->device);
+  }
+}
+
+Vec3 ExactSurface::closest_point(const Vec3& p) const {
+  Impl::Query q{impl_.get(), p, p, std::numeric_limits<double>::infinity()};
+  RTCPointQuery query{};
+  const Vec3 local = p - impl_->centre;
+  query.x = float(local.x());
+  query.y = float(local.y());
+  query.z = float(local.z());
+  query.radius = std::numeric_limits<float>::infinity();
+  query.time = 0.0f;
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  rtcPointQuery(impl_->scene, &query, &context, nullptr, &q);
+  return q.closest;
+}
+
+double ExactSurface::distance(const Vec3& p) const { return (closest_point(p) - p).norm(); }
+
+bool ExactSurface::inside(const Vec3& p) const {
+  // Skew directions, so that no ray runs along a face or through a vertex of axis-aligned meshes.
+  static const Vec3 directions[3] = {Vec3(0.5377, 0.8322, 0.1353).normalized(),
+                                     Vec3(-0.7071, 0.1534, -0.6902).normalized(),
+                                     Vec3(0.2213, -0.6547, 0.7229).normalized()};
+  int votes = 0;
+  for (const Vec3& d : directions) votes += impl_->crossings(p, d) % 2;
+  return votes >= 2;
+}
+
+}  // namespace mesh
+
+namespace mesh {
+std::string embree_version() { return RTC_VERSION_STRING; }
+}  // namespace mesh

@@ -1,0 +1,365 @@
+// Mesh checks and repair with CGAL Polygon Mesh Processing.
+#include "mesh/repair.hpp"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/border.h>
+#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/orientation.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/repair.h>
+#include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Polygon_mesh_processing/stitch_borders.h>
+#include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/box_intersection_d.h>
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <map>
+#include <numeric>
+#include <unordered_map>
+
+#include "core/error.hpp"
+#include "mesh/versions.hpp"
+#include "mesh/cgal_ops.hpp"
+
+namespace mesh {
+
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = K::Point_3;
+using SurfaceMesh = CGAL::Surface_mesh<Point>;
+namespace PMP = CGAL::Polygon_mesh_processing;
+using diefill::InputError;
+
+Point to_point(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+
+bool is_degenerate(const TriMesh& mesh, const Triangle& t) {
+  if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) return true;
+  return CGAL::collinear(to_point(mesh.vertices[t[0]]), to_point(mesh.vertices[t[1]]),
+                         to_point(mesh.vertices[t[2]]));
+}
+
+// Union-find over triangle indices, for shells.
+struct DisjointSets {
+  std::vector<std::size_t> parent;
+  explicit DisjointSets(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  std::size_t find(std::size_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  }
+  void unite(std::size_t a, std::size_t b) { parent[find(a)] = find(b); }
+};
+
+// Edge incidence of an indexed mesh: boundary, non-manifold and inconsistently oriented edges,
+// and shells (components connected through shared edges).
+void count_edges_and_shells(const TriMesh& mesh, MeshReport& report) {
+  struct Incidence {
+    int faces = 0;
+    int forward = 0;  // triangles running the edge from the smaller to the larger index
+    std::size_t first_face = 0;
+  };
+  std::unordered_map<std::uint64_t, Incidence> edges;
+  edges.reserve(mesh.triangles.size() * 2);
+  DisjointSets sets(mesh.triangles.size());
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    const Triangle& t = mesh.triangles[f];
+    for (int k = 0; k < 3; ++k) {
+      std::uint32_t a = std::uint32_t(t[k]), b = std::uint32_t(t[(k + 1) % 3]);
+      if (a == b) continue;
+      const bool forward = a < b;
+      if (!forward) std::swap(a, b);
+      Incidence& e = edges[(std::uint64_t(a) << 32) | b];
+      if (e.faces == 0) e.first_face = f;
+      else sets.unite(f, e.first_face);
+      ++e.faces;
+      e.forward += forward ? 1 : 0;
+    }
+  }
+  for (const auto& [key, e] : edges) {
+    if (e.faces == 1) ++report.boundary_edges;
+    else if (e.faces > 2) ++report.non_manifold_edges;
+    else if (e.forward != 1) ++report.inconsistent_edges;
+  }
+  std::vector<char> is_root(mesh.triangles.size(), 0);
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) is_root[sets.find(f)] = 1;
+  report.shells = std::size_t(std::count(is_root.begin(), is_root.end(), 1));
+}
+
+std::size_t count_duplicate_faces(const TriMesh& mesh) {
+  std::map<std::array<int, 3>, int> seen;
+  std::size_t duplicates = 0;
+  for (Triangle t : mesh.triangles) {
+    std::sort(t.begin(), t.end());
+    if (seen[t]++ > 0) ++duplicates;
+  }
+  return duplicates;
+}
+
+TriMesh to_trimesh(const SurfaceMesh& sm) {
+  TriMesh out;
+  std::vector<int> index(sm.number_of_vertices() + sm.number_of_removed_vertices(), -1);
+  for (auto v : sm.vertices()) {
+    index[v.idx()] = int(out.vertices.size());
+    const Point& p = sm.point(v);
+    out.vertices.emplace_back(p.x(), p.y(), p.z());
+  }
+  for (auto f : sm.faces()) {
+    Triangle t{};
+    int k = 0;
+    for (auto v : CGAL::vertices_around_face(sm.halfedge(f), sm)) {
+      if (k < 3) t[k] = index[v.idx()];
+      ++k;
+    }
+    if (k == 3) out.triangles.push_back(t);
+  }
+  return out;
+}
+
+double diameter_of_cycle(const SurfaceMesh& sm, SurfaceMesh::Halfedge_index start) {
+  Box box;
+  for (auto h : CGAL::halfedges_around_face(start, sm)) {
+    const Point& p = sm.point(sm.target(h));
+    box.extend(Vec3(p.x(), p.y(), p.z()));
+  }
+  return box.size().norm();
+}
+
+// Mean thickness 2V/A of a closed surface: a wrap around an open sheet is only about two
+// offsets thick, a real solid is many times thicker.
+double mean_thickness(const TriMesh& mesh) {
+  double area = 0.0;
+  for (const Triangle& t : mesh.triangles)
+    area += 0.5 * (mesh.vertices[t[1]] - mesh.vertices[t[0]])
+                      .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]])
+                      .norm();
+  return area > 0 ? 2.0 * std::abs(signed_volume(mesh)) / area : 0.0;
+}
+
+std::string mm(double metres) { return fmt::format("{:.4g} mm", metres * 1e3); }
+
+}  // namespace
+
+namespace detail {
+
+std::size_t count_self_intersections(const TriMesh& mesh) {
+  using BoxHandle = CGAL::Box_intersection_d::Box_with_handle_d<double, 3, std::size_t,
+                                                                CGAL::Box_intersection_d::ID_EXPLICIT>;
+  std::vector<BoxHandle> boxes;
+  boxes.reserve(mesh.triangles.size());
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    if (is_degenerate(mesh, mesh.triangles[f])) continue;  // reported as degenerate instead
+    const Triangle& t = mesh.triangles[f];
+    CGAL::Bbox_3 b = to_point(mesh.vertices[t[0]]).bbox() + to_point(mesh.vertices[t[1]]).bbox() +
+                     to_point(mesh.vertices[t[2]]).bbox();
+    boxes.emplace_back(b, f);
+  }
+  std::size_t pairs = 0;
+  auto test = [&](const BoxHandle& ba, const BoxHandle& bb) {
+    const Triangle& a = mesh.triangles[ba.handle()];
+    const Triangle& b = mesh.triangles[bb.handle()];
+    int shared = 0, sa = -1, sb = -1;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        if (a[i] == b[j]) ++shared, sa = i, sb = j;
+    auto P = [&](int v) { return to_point(mesh.vertices[v]); };
+    K::Triangle_3 ta(P(a[0]), P(a[1]), P(a[2])), tb(P(b[0]), P(b[1]), P(b[2]));
+    bool hit = false;
+    if (shared == 0) {
+      hit = CGAL::do_intersect(ta, tb);
+    } else if (shared == 1) {
+      // Touching at one vertex is fine; crossing elsewhere is not: test each triangle's edge
+      // opposite the shared vertex against the other triangle.
+      K::Segment_3 ea(P(a[(sa + 1) % 3]), P(a[(sa + 2) % 3]));
+      K::Segment_3 eb(P(b[(sb + 1) % 3]), P(b[(sb + 2) % 3]));
+      hit = CGAL::do_intersect(ea, tb) || CGAL::do_intersect(eb, ta);
+    }
+    if (hit) ++pairs;
+  };
+  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), test);
+  return pairs;
+}
+
+}  // namespace detail
+
+MeshReport inspect(const TriMesh& mesh) {
+  MeshReport r;
+  r.triangles = mesh.triangles.size();
+  r.vertices = mesh.vertices.size();
+  r.bbox = bounding_box(mesh);
+  for (const Triangle& t : mesh.triangles) {
+    if (is_degenerate(mesh, t)) ++r.degenerate_faces;
+    r.area_m2 += 0.5 * (mesh.vertices[t[1]] - mesh.vertices[t[0]])
+                           .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]])
+                           .norm();
+  }
+  r.duplicate_faces = count_duplicate_faces(mesh);
+  count_edges_and_shells(mesh, r);
+  r.self_intersections = detail::count_self_intersections(mesh);
+  r.closed = r.triangles > 0 && r.boundary_edges == 0 && r.non_manifold_edges == 0;
+  r.volume_m3 = signed_volume(mesh);
+  if (!r.closed) r.orientation = "undefined (open)";
+  else if (r.inconsistent_edges > 0) r.orientation = "inconsistent";
+  else r.orientation = r.volume_m3 >= 0 ? "outward" : "inward";
+  return r;
+}
+
+RepairResult repair(const TriMesh& input, const RepairOptions& options, const std::string& source) {
+  RepairResult result;
+  result.before = inspect(input);
+  const MeshReport& before = result.before;
+  if (before.triangles < 4)
+    throw InputError(source, "triangles",
+                     fmt::format("{} triangle(s) cannot enclose a solid", before.triangles),
+                     "Export the closed solid of the part, not a single face");
+
+  // 1. Soup level: merge duplicate points, drop triangles with repeated vertices, and keep one
+  //    of each duplicated triangle (either winding: double-sided surfaces become single).
+  std::vector<Point> points;
+  points.reserve(input.vertices.size());
+  for (const Vec3& v : input.vertices) points.push_back(to_point(v));
+  std::vector<std::vector<std::size_t>> polygons;
+  polygons.reserve(input.triangles.size());
+  for (const Triangle& t : input.triangles)
+    polygons.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
+  PMP::repair_polygon_soup(points, polygons);
+  if (polygons.size() != input.triangles.size())
+    result.actions.push_back(fmt::format("removed {} duplicate or repeated-vertex triangles",
+                                         input.triangles.size() - polygons.size()));
+
+  // 2. Orient the soup consistently (duplicating non-manifold vertices) and stitch the borders
+  //    that only failed to share vertices.
+  if (!PMP::orient_polygon_soup(points, polygons))
+    result.actions.push_back("split non-manifold vertices to orient the surface");
+  SurfaceMesh sm;
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, sm);
+  const std::size_t borders_before = before.boundary_edges;
+  PMP::stitch_borders(sm);
+  PMP::remove_degenerate_faces(sm);
+  sm.collect_garbage();
+
+  // 3. Fill holes up to the allowed diameter.
+  std::vector<SurfaceMesh::Halfedge_index> cycles;
+  PMP::extract_boundary_cycles(sm, std::back_inserter(cycles));
+  double largest_open_hole = 0.0;
+  std::size_t open_holes = 0;
+  for (auto h : cycles) {
+    const double diameter = diameter_of_cycle(sm, h);
+    if (diameter <= options.max_hole_m) {
+      std::vector<SurfaceMesh::Face_index> patch;
+      PMP::triangulate_and_refine_hole(sm, h, std::back_inserter(patch),
+                                       CGAL::Emptyset_iterator());
+      ++result.holes_filled;
+    } else {
+      ++open_holes;
+      largest_open_hole = std::max(largest_open_hole, diameter);
+    }
+  }
+  if (result.holes_filled > 0)
+    result.actions.push_back(fmt::format("filled {} hole(s) up to {} across",
+                                         result.holes_filled, mm(options.max_hole_m)));
+  if (borders_before > 0 && cycles.size() == 0)
+    result.actions.push_back("stitched borders that did not share vertices");
+
+  TriMesh repaired = to_trimesh(sm);
+  const bool closed = CGAL::is_closed(sm) && open_holes == 0;
+  const bool self_intersecting = closed && detail::count_self_intersections(repaired) > 0;
+  bool geometry_changed = result.holes_filled > 0;
+
+  if (closed && !self_intersecting) {
+    // 4. A closed surface: reject shells nested inside others (internal voids or duplicated
+    //    offset surfaces are no die), then orient every shell outward.
+    std::vector<std::size_t> nesting;
+    auto volume_ids = sm.add_property_map<SurfaceMesh::Face_index, std::size_t>("f:vid").first;
+    PMP::volume_connected_components(
+        sm, volume_ids,
+        CGAL::parameters::do_orientation_tests(false).nesting_levels(std::ref(nesting)));
+    const std::size_t nested = std::size_t(
+        std::count_if(nesting.begin(), nesting.end(), [](std::size_t l) { return l > 0; }));
+    if (nested > 0)
+      throw InputError(source, "shells",
+                       fmt::format("{} of {} closed shells lie inside another shell (an internal "
+                                   "void or a duplicated surface)",
+                                   nested, nesting.size()),
+                       "A die cavity or grain must be a solid without voids: remove the inner "
+                       "shell(s) in CAD");
+    const double volume_before = signed_volume(repaired);
+    PMP::orient_to_bound_a_volume(sm);
+    repaired = to_trimesh(sm);
+    if (signed_volume(repaired) != volume_before || before.inconsistent_edges > 0)
+      result.actions.push_back("oriented every shell outward");
+  } else {
+    // 5. Still open or self-intersecting: wrap it, unless the holes are beyond what a wrap
+    //    within the tolerance can close.
+    const std::string defect =
+        !closed ? fmt::format("the mesh is open ({} boundary edges; largest hole {} across)",
+                              before.boundary_edges, mm(largest_open_hole))
+                : fmt::format("the surface intersects itself ({} triangle pairs)",
+                              detail::count_self_intersections(repaired));
+    if (!options.allow_wrap)
+      throw InputError(source, "surface", defect,
+                       "Repair the mesh in CAD, or allow the alpha-wrap fallback");
+    const double alpha = 2.0 * options.tolerance_m;
+    const double offset = 0.25 * options.tolerance_m;
+    TriMesh wrapped = detail::alpha_wrap(input, alpha, offset);
+    if (wrapped.triangles.empty() || mean_thickness(wrapped) < 10.0 * offset)
+      throw InputError(source, "boundary edges",
+                       defect + "; it does not enclose a volume, and wrapping it within the "
+                                "tolerance " + mm(options.tolerance_m) + " gives only a thin sheet",
+                       fmt::format("Close the mesh in CAD, or raise the largest hole to fill "
+                                   "(--max-hole, now {})",
+                                   mm(options.max_hole_m)));
+    result.actions.push_back(fmt::format("{}: alpha-wrapped (alpha {}, offset {})", defect,
+                                         mm(alpha), mm(offset)));
+    result.wrapped = true;
+    repaired = std::move(wrapped);
+    geometry_changed = true;
+  }
+
+  if (geometry_changed) {
+    result.hausdorff_m = std::max(detail::max_distance(input, repaired),
+                                  detail::max_distance(repaired, input));
+    if (result.hausdorff_m > options.tolerance_m)
+      throw InputError(source, "tolerance",
+                       fmt::format("repair would move the surface by up to {} ({}), more than the "
+                                   "tolerance {}",
+                                   mm(result.hausdorff_m),
+                                   result.actions.empty() ? "repair" : result.actions.back(),
+                                   mm(options.tolerance_m)),
+                       "Repair the mesh in CAD, or raise the tolerance (--tolerance) if that "
+                       "change is acceptable");
+  }
+  result.mesh = std::move(repaired);
+  result.after = inspect(result.mesh);
+  result.repaired = !result.actions.empty();
+  return result;
+}
+
+std::string format_report(const MeshReport& r) {
+  std::string out;
+  out += fmt::format("  triangles            {}\n", r.triangles);
+  out += fmt::format("  vertices             {}\n", r.vertices);
+  out += fmt::format("  shells               {}\n", r.shells);
+  out += fmt::format("  boundary edges       {}\n", r.boundary_edges);
+  out += fmt::format("  non-manifold edges   {}\n", r.non_manifold_edges);
+  out += fmt::format("  inconsistent edges   {}\n", r.inconsistent_edges);
+  out += fmt::format("  degenerate faces     {}\n", r.degenerate_faces);
+  out += fmt::format("  duplicate faces      {}\n", r.duplicate_faces);
+  out += fmt::format("  self-intersections   {}\n", r.self_intersections);
+  out += fmt::format("  closed               {}\n", r.closed ? "yes" : "no");
+  out += fmt::format("  orientation          {}\n", r.orientation);
+  out += fmt::format("  volume               {:.6g} mm³\n", r.volume_m3 * 1e9);
+  if (!r.bbox.empty())
+    out += fmt::format("  bounding box         [{:.4g}, {:.4g}, {:.4g}] – [{:.4g}, {:.4g}, {:.4g}] mm\n",
+                       r.bbox.lo.x() * 1e3, r.bbox.lo.y() * 1e3, r.bbox.lo.z() * 1e3,
+                       r.bbox.hi.x() * 1e3, r.bbox.hi.y() * 1e3, r.bbox.hi.z() * 1e3);
+  return out;
+}
+
+}  // namespace mesh
+
+namespace mesh {
+std::string cgal_version() { return CGAL_VERSION_STR; }
+}  // namespace mesh

@@ -1,0 +1,56 @@
+#pragma once
+// Mesh checks and repair (CGAL Polygon Mesh Processing). A die or grain mesh must become a
+// closed, outward-oriented, non-self-intersecting solid before a signed distance means anything.
+// Repair never moves geometry by more than the user's tolerance without an error saying so.
+#include <string>
+#include <vector>
+
+#include "mesh/trimesh.hpp"
+
+namespace mesh {
+
+struct MeshReport {
+  std::size_t triangles = 0;
+  std::size_t vertices = 0;
+  std::size_t boundary_edges = 0;      // edges with one triangle: holes
+  std::size_t non_manifold_edges = 0;  // edges with three or more triangles
+  std::size_t inconsistent_edges = 0;  // edges whose two triangles run the same way
+  std::size_t degenerate_faces = 0;    // zero area (collinear or repeated vertices)
+  std::size_t duplicate_faces = 0;     // same three vertices as an earlier triangle
+  std::size_t self_intersections = 0;  // pairs of intersecting, non-adjacent triangles
+  std::size_t shells = 0;              // edge-connected components
+  bool closed = false;
+  std::string orientation;  // "outward", "inward", "inconsistent" or "undefined (open)"
+  double volume_m3 = 0.0;   // signed, by the divergence theorem
+  double area_m2 = 0.0;
+  Box bbox;
+};
+
+// All checks of the report, on a welded mesh as imported.
+MeshReport inspect(const TriMesh& mesh);
+
+struct RepairOptions {
+  double tolerance_m = 5e-5;      // largest surface displacement repair may introduce
+  double max_hole_m = 1e-3;       // holes up to this diameter are filled
+  bool allow_wrap = true;         // fall back to alpha wrapping for what stays broken
+};
+
+struct RepairResult {
+  TriMesh mesh;  // closed, outward, without self-intersections
+  MeshReport before, after;
+  std::vector<std::string> actions;  // each step that changed something, human readable
+  bool repaired = false;             // anything changed at all
+  bool wrapped = false;              // alpha wrapping was used
+  std::size_t holes_filled = 0;
+  double hausdorff_m = 0.0;          // largest deviation from the input surface introduced
+};
+
+// Repairs `mesh` or throws diefill::InputError naming `source` and the defect that could not
+// be repaired within the tolerance (an open mesh with large holes, nested shells, a change
+// larger than the tolerance, too few triangles).
+RepairResult repair(const TriMesh& mesh, const RepairOptions& options, const std::string& source);
+
+// A readable multi-line summary (for `diefill sdf` and logs).
+std::string format_report(const MeshReport& report);
+
+}  // namespace mesh

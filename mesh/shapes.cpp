@@ -1,0 +1,107 @@
+#include "mesh/shapes.hpp"
+
+#include <cmath>
+#include <numbers>
+
+#include "core/error.hpp"
+
+namespace mesh {
+
+namespace {
+constexpr double pi = std::numbers::pi;
+
+// Adds a ring of `n` vertices at height z; returns the index of the first.
+int add_circle(TriMesh& m, double radius, double z, int n) {
+  const int first = int(m.vertices.size());
+  for (int i = 0; i < n; ++i) {
+    const double a = 2.0 * pi * i / n;
+    m.vertices.emplace_back(radius * std::cos(a), radius * std::sin(a), z);
+  }
+  return first;
+}
+
+// Quad strip between two circles of n vertices a and b. Unflipped, the normal is the tangent
+// (counter-clockwise about z) crossed with b - a: away from the axis for a wall from a below to
+// b above, and -z for an annulus from a inside to b outside.
+void add_strip(TriMesh& m, int a, int b, int n, bool flip) {
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    if (!flip) {
+      m.triangles.push_back({a + i, a + j, b + j});
+      m.triangles.push_back({a + i, b + j, b + i});
+    } else {
+      m.triangles.push_back({a + i, b + j, a + j});
+      m.triangles.push_back({a + i, b + i, b + j});
+    }
+  }
+}
+
+// Fan from a centre vertex over a circle; `up` gives a normal along +z.
+void add_fan(TriMesh& m, int centre, int ring, int n, bool up) {
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    if (up) m.triangles.push_back({centre, ring + i, ring + j});
+    else m.triangles.push_back({centre, ring + j, ring + i});
+  }
+}
+}  // namespace
+
+double chord_error(double radius, int segments) {
+  return radius * (1.0 - std::cos(pi / segments));
+}
+
+int circle_segments(double radius, double chord_tolerance) {
+  int n = int(std::ceil(pi / std::acos(1.0 - chord_tolerance / radius)));
+  return std::max(8, (n + 7) / 8 * 8);
+}
+
+TriMesh ring_cavity(double outer_diameter, double inner_diameter, double depth,
+                    double chord_tolerance) {
+  TriMesh m;
+  const double ro = outer_diameter / 2, ri = inner_diameter / 2;
+  const int n = circle_segments(ro, chord_tolerance);
+  const int outer_bottom = add_circle(m, ro, -depth, n);
+  const int outer_top = add_circle(m, ro, 0.0, n);
+  add_strip(m, outer_bottom, outer_top, n, false);  // normals away from the axis
+  if (ri > 0) {
+    const int inner_bottom = add_circle(m, ri, -depth, n);
+    const int inner_top = add_circle(m, ri, 0.0, n);
+    add_strip(m, inner_bottom, inner_top, n, true);  // normals towards the axis
+    add_strip(m, inner_top, outer_top, n, true);        // top annulus, normal +z
+    add_strip(m, inner_bottom, outer_bottom, n, false);  // floor annulus, normal -z
+  } else {
+    const int top_centre = int(m.vertices.size());
+    m.vertices.emplace_back(0.0, 0.0, 0.0);
+    const int bottom_centre = int(m.vertices.size());
+    m.vertices.emplace_back(0.0, 0.0, -depth);
+    add_fan(m, top_centre, outer_top, n, true);
+    add_fan(m, bottom_centre, outer_bottom, n, false);
+  }
+  return m;
+}
+
+TriMesh box_solid(const Vec3& lo, const Vec3& hi) {
+  TriMesh m;
+  for (int i = 0; i < 8; ++i)
+    m.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
+  // Each face as a quad, counter-clockwise seen from outside.
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) {
+    m.triangles.push_back({q[0], q[1], q[2]});
+    m.triangles.push_back({q[0], q[2], q[3]});
+  }
+  return m;
+}
+
+std::vector<std::string> bundled_die_names() { return {"disc", "ring"}; }
+
+TriMesh bundled_die(const std::string& name) {
+  // Chord error 5 µm: half the 0.01 mm the dies must meet.
+  constexpr double chord = 5e-6;
+  if (name == "disc") return ring_cavity(20e-3, 0.0, 10e-3, chord);
+  if (name == "ring") return ring_cavity(20e-3, 10e-3, 10e-3, chord);
+  throw diefill::InputError("", "die", "unknown bundled die '" + name + "'", "Use disc or ring");
+}
+
+}  // namespace mesh

@@ -1,0 +1,26 @@
+#pragma once
+// Reproducible geometry made by the program itself: the bundled dies (cavity meshes, top face
+// on the die table at z = 0) and simple test solids.
+#include "mesh/trimesh.hpp"
+
+namespace mesh {
+
+// Segments a circle of `radius` needs so that no chord strays more than `chord_error` from it,
+// rounded up to a multiple of 8 so that the mesh is mirror-symmetric about the x and y axes.
+int circle_segments(double radius, double chord_error);
+
+// Annular (or, with inner_diameter = 0, cylindrical) cavity: top face at z = 0, floor at
+// z = -depth, outward-oriented, closed. Lengths in metres.
+TriMesh ring_cavity(double outer_diameter, double inner_diameter, double depth, double chord_error);
+
+// Axis-aligned box [lo, hi], outward-oriented, two triangles a face.
+TriMesh box_solid(const Vec3& lo, const Vec3& hi);
+
+// The bundled dies by name ("ring", "disc"); throws InputError for other names.
+TriMesh bundled_die(const std::string& name);
+std::vector<std::string> bundled_die_names();
+
+// Largest distance between a circle and its inscribed polygon of `segments` sides.
+double chord_error(double radius, int segments);
+
+}  // namespace mesh

@@ -1,0 +1,58 @@
+#include "mesh/trimesh.hpp"
+
+#include "core/error.hpp"
+#include "mesh/versions.hpp"
+
+namespace mesh {
+
+Box bounding_box(const TriMesh& mesh) {
+  Box box;
+  for (const Vec3& v : mesh.vertices) box.extend(v);
+  return box;
+}
+
+double signed_volume(const TriMesh& mesh) {
+  double six_volume = 0.0;
+  for (const Triangle& t : mesh.triangles) {
+    const Vec3& a = mesh.vertices[t[0]];
+    const Vec3& b = mesh.vertices[t[1]];
+    const Vec3& c = mesh.vertices[t[2]];
+    six_volume += a.dot(b.cross(c));
+  }
+  return six_volume / 6.0;
+}
+
+double metres_per_unit(LengthUnit unit) {
+  switch (unit) {
+    case LengthUnit::mm: return 1e-3;
+    case LengthUnit::m: return 1.0;
+    case LengthUnit::in: return 0.0254;
+  }
+  return 1.0;
+}
+
+std::string_view unit_name(LengthUnit unit) {
+  switch (unit) {
+    case LengthUnit::mm: return "mm";
+    case LengthUnit::m: return "m";
+    case LengthUnit::in: return "in";
+  }
+  return "?";
+}
+
+LengthUnit parse_unit(std::string_view text, std::string_view field) {
+  if (text == "mm") return LengthUnit::mm;
+  if (text == "m") return LengthUnit::m;
+  if (text == "in" || text == "inch") return LengthUnit::in;
+  throw diefill::InputError("", std::string(field), "unknown length unit '" + std::string(text) + "'",
+                            "Use mm, m or in");
+}
+
+}  // namespace mesh
+
+namespace mesh {
+std::string eigen_version() {
+  return std::to_string(EIGEN_WORLD_VERSION) + "." + std::to_string(EIGEN_MAJOR_VERSION) + "." +
+         std::to_string(EIGEN_MINOR_VERSION);
+}
+}  // namespace mesh

@@ -1,0 +1,43 @@
+#pragma once
+// The plain triangle mesh every stage passes around: vertex positions in metres (SI inside the
+// code) and triangles as vertex index triples, counter-clockwise seen from outside.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace mesh {
+
+using Vec3 = Eigen::Vector3d;
+using Triangle = std::array<int, 3>;
+
+struct TriMesh {
+  std::vector<Vec3> vertices;       // [m]
+  std::vector<Triangle> triangles;  // indices into vertices
+};
+
+struct Box {
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+  Vec3 hi = Vec3::Constant(-std::numeric_limits<double>::infinity());
+  void extend(const Vec3& p) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  bool empty() const { return !(lo.array() <= hi.array()).all(); }
+  Vec3 size() const { return hi - lo; }
+};
+
+Box bounding_box(const TriMesh& mesh);
+// Signed volume by the divergence theorem [m³]: positive for a closed mesh oriented outward.
+double signed_volume(const TriMesh& mesh);
+
+// Length units a mesh file may declare (files store none).
+enum class LengthUnit { mm, m, in };
+double metres_per_unit(LengthUnit unit);
+std::string_view unit_name(LengthUnit unit);
+// Throws diefill::InputError naming `field` when `text` is not mm, m or in.
+LengthUnit parse_unit(std::string_view text, std::string_view field);
+
+}  // namespace mesh

@@ -1,0 +1,86 @@
+// Alpha wrapping and surface distances: the CGAL AABB-tree side of the mesh module.
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/alpha_wrap_3.h>
+
+#include <array>
+#include <vector>
+
+#include "mesh/cgal_ops.hpp"
+
+namespace mesh::detail {
+
+namespace {
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = K::Point_3;
+using Triangle3 = K::Triangle_3;
+using TriangleIt = std::vector<Triangle3>::const_iterator;
+using Primitive = CGAL::AABB_triangle_primitive<K, TriangleIt>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
+
+Point to_point(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+
+std::vector<Triangle3> triangles_of(const TriMesh& mesh) {
+  std::vector<Triangle3> out;
+  out.reserve(mesh.triangles.size());
+  for (const Triangle& t : mesh.triangles)
+    out.emplace_back(to_point(mesh.vertices[t[0]]), to_point(mesh.vertices[t[1]]),
+                     to_point(mesh.vertices[t[2]]));
+  return out;
+}
+}  // namespace
+
+TriMesh alpha_wrap(const TriMesh& soup, double alpha, double offset) {
+  std::vector<Point> points;
+  points.reserve(soup.vertices.size());
+  for (const Vec3& v : soup.vertices) points.push_back(to_point(v));
+  std::vector<std::array<std::size_t, 3>> faces;
+  faces.reserve(soup.triangles.size());
+  for (const Triangle& t : soup.triangles)
+    faces.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
+
+  CGAL::Surface_mesh<Point> wrap;
+  CGAL::alpha_wrap_3(points, faces, alpha, offset, wrap);
+
+  TriMesh out;
+  std::vector<int> index(wrap.number_of_vertices() + wrap.number_of_removed_vertices(), -1);
+  for (auto v : wrap.vertices()) {
+    index[v.idx()] = int(out.vertices.size());
+    const Point& p = wrap.point(v);
+    out.vertices.emplace_back(p.x(), p.y(), p.z());
+  }
+  for (auto f : wrap.faces()) {
+    Triangle t{};
+    int k = 0;
+    for (auto v : CGAL::vertices_around_face(wrap.halfedge(f), wrap)) t[k++] = index[v.idx()];
+    out.triangles.push_back(t);
+  }
+  return out;
+}
+
+double max_distance(const TriMesh& from, const TriMesh& to) {
+  const std::vector<Triangle3> target = triangles_of(to);
+  if (target.empty() || from.triangles.empty()) return 0.0;
+  Tree tree(target.begin(), target.end());
+  tree.accelerate_distance_queries();
+  double worst_squared = 0.0;
+  auto probe = [&](const Vec3& p) {
+    worst_squared = std::max(worst_squared, tree.squared_distance(to_point(p)));
+  };
+  for (const Vec3& v : from.vertices) probe(v);
+  for (const Triangle& t : from.triangles) {
+    const Vec3& a = from.vertices[t[0]];
+    const Vec3& b = from.vertices[t[1]];
+    const Vec3& c = from.vertices[t[2]];
+    probe((a + b + c) / 3.0);
+    probe((a + b) / 2.0);
+    probe((b + c) / 2.0);
+    probe((c + a) / 2.0);
+  }
+  return std::sqrt(worst_squared);
+}
+
+}  // namespace mesh::detail

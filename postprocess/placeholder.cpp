@@ -1,0 +1,1 @@
+// Density fields arrive with issue 4.
