@@ -39,16 +39,20 @@ int run_sdf(const SdfCommand& c) {
              double(die.sdf.memory_bytes()) / (1 << 20));
   if (c.verify > 0) {
     const mesh::ExactSurface exact(die.solid);
-    const mesh::SdfVerification v = mesh::verify_sdf(die.sdf, die.solid, exact, c.verify, c.seed);
-    fmt::print("verify: {} points in the band (seed {})\n", v.samples, c.seed);
-    fmt::print("  |SDF - exact|  max {:.4f} voxel, mean {:.5f} voxel\n", v.max_error_voxels,
-               v.mean_error_voxels);
-    fmt::print("  farther than one voxel from a sharp edge ({} points): max {:.4f} voxel at "
-               "({:.4f}, {:.4f}, {:.4f}) mm\n",
-               v.smooth_samples, v.max_error_smooth_voxels, v.worst_smooth_point.x() / mm,
-               v.worst_smooth_point.y() / mm, v.worst_smooth_point.z() / mm);
-    fmt::print("  sign disagreements: {} of {} points with |exact| > 0.5 voxel\n",
-               v.sign_disagreements, v.sign_checked);
+    const mesh::WallField field = die.sdf.wall_field(die.solid);
+    const mesh::SdfVerification v = mesh::verify_sdf(field, die.solid, exact, c.verify, c.seed);
+    fmt::print("verify: {} points in the band (seed {}), {} farther than a voxel from a sharp "
+               "edge, {} with |exact| > 0.5 voxel\n",
+               v.samples, c.seed, v.smooth_samples, v.sign_checked);
+    auto show = [&](const char* what, const mesh::SdfErrors& e) {
+      fmt::print("  {}: |SDF - exact| max {:.3g} voxel, mean {:.3g} voxel; away from sharp edges "
+                 "max {:.3g} voxel at ({:.4f}, {:.4f}, {:.4f}) mm; sign disagreements {}\n",
+                 what, e.max_voxels, e.mean_voxels, e.max_smooth_voxels,
+                 e.worst_smooth_point.x() / mm, e.worst_smooth_point.y() / mm,
+                 e.worst_smooth_point.z() / mm, e.sign_disagreements);
+    };
+    show("wall query (what the simulation uses)", v.query);
+    show("grid, trilinear", v.grid);
   }
   if (!c.output.empty()) {
     die.sdf.write(c.output);

@@ -4,6 +4,7 @@
 
 #include "app/commands.hpp"
 #include "core/error.hpp"
+#include "core/log.hpp"
 
 namespace {
 
@@ -38,6 +39,11 @@ int main(int argc, char** argv) {
   CLI::App root{"diefill: simulate how a powder fills a press die"};
   root.set_version_flag("--version", [] { return app::version_text(); });
   root.require_subcommand(1);
+  bool verbose = false;
+  root.add_flag("-v,--verbose", verbose, "Log each stage with its time");
+  root.parse_complete_callback([&] {
+    if (verbose) diefill::log::set_level(diefill::log::Level::verbose);
+  });
   std::function<int()> action;
   app::SdfCommand sdf;
   app::DieCommand die;

@@ -17,3 +17,12 @@ double max_distance(const TriMesh& from, const TriMesh& to);
 std::size_t count_self_intersections(const TriMesh& mesh);
 
 }  // namespace mesh::detail
+
+namespace mesh::detail {
+
+// Union of closed shells that intersect each other but not themselves (a gear set in mesh,
+// engravings on a disc), by CGAL corefinement: exact, no tolerance spent. Returns false when a
+// shell is open or intersects itself, or a union step fails; then `out` is unspecified.
+bool union_of_shells(const TriMesh& closed_shells, TriMesh& out);
+
+}  // namespace mesh::detail

@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/sha256.hpp"
+#include "core/timer.hpp"
 
 namespace mesh {
 
@@ -200,7 +201,9 @@ PreparedDie prepare_die(const fs::path& path, const DieOptions& options,
     out.table_z = out.after.bbox.hi.z();
   }
 
+  diefill::Stopwatch clock;
   out.sdf = build_sdf(out.solid, {options.voxel_m, options.exterior_band_m, options.interior_band_m});
+  diefill::log::debug("sdf: {} active voxels in {:.2f} s", out.sdf.active_voxels(), clock.seconds());
   out.sdf.set_metadata("role", std::string(role_name(options.role)));
   out.sdf.set_metadata("source_sha256", out.sha256);
   out.sdf.set_metadata("source", path.filename().string());

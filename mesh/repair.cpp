@@ -14,6 +14,7 @@
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/box_intersection_d.h>
 #include <fmt/core.h>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <map>
@@ -21,6 +22,8 @@
 #include <unordered_map>
 
 #include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/timer.hpp"
 #include "mesh/versions.hpp"
 #include "mesh/cgal_ops.hpp"
 
@@ -140,6 +143,10 @@ double mean_thickness(const TriMesh& mesh) {
 
 std::string mm(double metres) { return fmt::format("{:.4g} mm", metres * 1e3); }
 
+// Alpha wraps beyond this size take minutes on two cores (1.4 million triangles: 250 s); the user is asked to repair
+// the mesh or accept a coarser tolerance instead.
+constexpr double max_wrap_triangles = 3e5;
+
 }  // namespace
 
 namespace detail {
@@ -208,7 +215,9 @@ MeshReport inspect(const TriMesh& mesh) {
 
 RepairResult repair(const TriMesh& input, const RepairOptions& options, const std::string& source) {
   RepairResult result;
+  diefill::Stopwatch clock;
   result.before = inspect(input);
+  diefill::log::debug("repair: inspected in {:.2f} s", clock.seconds());
   const MeshReport& before = result.before;
   if (before.triangles < 4)
     throw InputError(source, "triangles",
@@ -263,13 +272,34 @@ RepairResult repair(const TriMesh& input, const RepairOptions& options, const st
   if (borders_before > 0 && cycles.size() == 0)
     result.actions.push_back("stitched borders that did not share vertices");
 
+  diefill::log::debug("repair: soup, orientation, stitching and holes done at {:.2f} s", clock.seconds());
   TriMesh repaired = to_trimesh(sm);
   const bool closed = CGAL::is_closed(sm) && open_holes == 0;
-  const bool self_intersecting = closed && detail::count_self_intersections(repaired) > 0;
+  bool self_intersecting = closed && detail::count_self_intersections(repaired) > 0;
   bool geometry_changed = result.holes_filled > 0;
 
+  // 4. Closed shells that intersect each other (gears in mesh, engravings on a disc): their
+  //    exact union, which moves no surface that stays on the outside.
+  if (closed && self_intersecting) {
+    TriMesh united;
+    if (detail::union_of_shells(repaired, united)) {
+      result.actions.push_back(fmt::format("united {} intersecting shells (exact corefinement)",
+                                           before.shells));
+      repaired = std::move(united);
+      sm.clear();
+      std::vector<Point> pts;
+      for (const Vec3& v : repaired.vertices) pts.push_back(to_point(v));
+      std::vector<std::array<std::size_t, 3>> tris;
+      for (const Triangle& t : repaired.triangles)
+        tris.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
+      PMP::polygon_soup_to_polygon_mesh(pts, tris, sm);
+      self_intersecting = false;
+      diefill::log::debug("repair: union done at {:.2f} s", clock.seconds());
+    }
+  }
+
   if (closed && !self_intersecting) {
-    // 4. A closed surface: reject shells nested inside others (internal voids or duplicated
+    // 5. A closed surface: reject shells nested inside others (internal voids or duplicated
     //    offset surfaces are no die), then orient every shell outward.
     std::vector<std::size_t> nesting;
     auto volume_ids = sm.add_property_map<SurfaceMesh::Face_index, std::size_t>("f:vid").first;
@@ -291,19 +321,36 @@ RepairResult repair(const TriMesh& input, const RepairOptions& options, const st
     if (signed_volume(repaired) != volume_before || before.inconsistent_edges > 0)
       result.actions.push_back("oriented every shell outward");
   } else {
-    // 5. Still open or self-intersecting: wrap it, unless the holes are beyond what a wrap
-    //    within the tolerance can close.
-    const std::string defect =
-        !closed ? fmt::format("the mesh is open ({} boundary edges; largest hole {} across)",
-                              before.boundary_edges, mm(largest_open_hole))
-                : fmt::format("the surface intersects itself ({} triangle pairs)",
-                              detail::count_self_intersections(repaired));
+    // 6. Still open or self-intersecting: wrap it, unless the holes are beyond what a wrap
+    //    within the tolerance can close, or the wrap would be too fine to afford.
+    std::string defect = "the mesh is not a closed solid";
+    {
+      std::vector<std::string> parts;
+      if (!closed && before.boundary_edges > 0)
+        parts.push_back(fmt::format("{} boundary edges, largest remaining hole {} across",
+                                    before.boundary_edges, mm(largest_open_hole)));
+      if (before.non_manifold_edges > 0)
+        parts.push_back(fmt::format("{} non-manifold edges", before.non_manifold_edges));
+      if (const std::size_t crossing = detail::count_self_intersections(repaired); crossing > 0)
+        parts.push_back(fmt::format("{} pairs of intersecting triangles", crossing));
+      if (!parts.empty()) defect += " (" + fmt::format("{}", fmt::join(parts, "; ")) + ")";
+    }
     if (!options.allow_wrap)
       throw InputError(source, "surface", defect,
                        "Repair the mesh in CAD, or allow the alpha-wrap fallback");
     const double alpha = 2.0 * options.tolerance_m;
     const double offset = 0.25 * options.tolerance_m;
+    // A wrap has about 2 A / alpha² triangles; beyond a few million it takes many minutes.
+    const double expected_triangles = 2.0 * before.area_m2 / (alpha * alpha);
+    if (expected_triangles > max_wrap_triangles)
+      throw InputError(source, "surface",
+                       fmt::format("{}, and wrapping it within the tolerance {} would take about "
+                                   "{:.3g} million triangles",
+                                   defect, mm(options.tolerance_m), expected_triangles / 1e6),
+                       "Repair the mesh in CAD, or raise the tolerance (--tolerance)");
     TriMesh wrapped = detail::alpha_wrap(input, alpha, offset);
+    diefill::log::debug("repair: alpha wrap ({} triangles) done at {:.2f} s", wrapped.triangles.size(),
+                        clock.seconds());
     if (wrapped.triangles.empty() || mean_thickness(wrapped) < 10.0 * offset)
       throw InputError(source, "boundary edges",
                        defect + "; it does not enclose a volume, and wrapping it within the "
@@ -318,6 +365,7 @@ RepairResult repair(const TriMesh& input, const RepairOptions& options, const st
     geometry_changed = true;
   }
 
+  diefill::log::debug("repair: closed-surface checks done at {:.2f} s", clock.seconds());
   if (geometry_changed) {
     result.hausdorff_m = std::max(detail::max_distance(input, repaired),
                                   detail::max_distance(repaired, input));

@@ -38,6 +38,7 @@ struct TriMeshAdapter {
 
 struct SdfGrid::Impl {
   openvdb::FloatGrid::Ptr grid;
+  openvdb::Int32Grid::Ptr closest;  // index of the closest triangle, per band voxel
   std::map<std::string, std::string> metadata;
 };
 
@@ -117,6 +118,52 @@ std::vector<SdfLeaf> SdfGrid::leaves() const {
   return out;
 }
 
+WallField SdfGrid::wall_field(const TriMesh& solid) const {
+  WallField w;
+  w.set_surface(solid);
+  w.voxel = voxel_size();
+  w.background = float(background());
+  const auto& tree = impl_->grid->tree();
+  const openvdb::CoordBBox box = impl_->grid->evalActiveVoxelBoundingBox();
+  for (int d = 0; d < 3; ++d) {
+    w.brick_min[std::size_t(d)] = box.min()[d] >> 3;
+    w.brick_count[std::size_t(d)] = (box.max()[d] >> 3) - (box.min()[d] >> 3) + 1;
+  }
+  const std::size_t cells = std::size_t(w.brick_count[0]) * std::size_t(w.brick_count[1]) *
+                            std::size_t(w.brick_count[2]);
+  w.brick_of_cell.assign(cells, -1);
+  // Cells without a leaf lie wholly inside or outside: the tiles' sign says which.
+  auto acc = impl_->grid->getConstAccessor();
+  auto cell_of = [&](const openvdb::Coord& origin) {
+    return (std::size_t((origin.x() >> 3) - w.brick_min[0]) * std::size_t(w.brick_count[1]) +
+            std::size_t((origin.y() >> 3) - w.brick_min[1])) *
+               std::size_t(w.brick_count[2]) +
+           std::size_t((origin.z() >> 3) - w.brick_min[2]);
+  };
+  for (int i = 0; i < w.brick_count[0]; ++i)
+    for (int j = 0; j < w.brick_count[1]; ++j)
+      for (int k = 0; k < w.brick_count[2]; ++k) {
+        const openvdb::Coord origin((w.brick_min[0] + i) * 8, (w.brick_min[1] + j) * 8,
+                                    (w.brick_min[2] + k) * 8);
+        if (acc.getValue(origin) < 0) w.brick_of_cell[cell_of(origin)] = -2;
+      }
+  auto closest_acc = impl_->closest->getConstAccessor();
+  const std::size_t leaves = tree.leafCount();
+  w.distance.reserve(leaves * 512);
+  w.closest.reserve(leaves * 512);
+  std::int32_t brick = 0;
+  for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf, ++brick) {
+    w.brick_of_cell[cell_of(leaf->origin())] = brick;
+    const auto* index_leaf = closest_acc.probeConstLeaf(leaf->origin());
+    for (openvdb::Index n = 0; n < 512; ++n) {
+      w.distance.push_back(leaf->getValue(n));
+      const bool band = leaf->isValueOn(n) && index_leaf && index_leaf->isValueOn(n);
+      w.closest.push_back(band ? index_leaf->getValue(n) : -1);
+    }
+  }
+  return w;
+}
+
 const std::map<std::string, std::string>& SdfGrid::metadata() const { return impl_->metadata; }
 
 void SdfGrid::set_metadata(const std::string& key, const std::string& value) {
@@ -127,13 +174,15 @@ void SdfGrid::write(const std::filesystem::path& path) const {
   initialise_openvdb();
   openvdb::FloatGrid::Ptr grid = impl_->grid->deepCopy();
   grid->setName("sdf");
+  openvdb::Int32Grid::Ptr closest = impl_->closest->deepCopy();
+  closest->setName("closest_triangle");
   for (const auto& [key, value] : impl_->metadata) grid->insertMeta(key, openvdb::StringMetadata(value));
   grid->insertMeta("units", openvdb::StringMetadata("m"));
   grid->insertMeta("voxel_size_m", openvdb::DoubleMetadata(voxel_size()));
   diefill::PendingFile pending(path);
   try {
     openvdb::io::File file(pending.path().string());
-    file.write({grid});
+    file.write({grid, closest});
     file.close();
   } catch (const openvdb::Exception& e) {
     throw diefill::InputError(path.string(), "", std::string("cannot be written: ") + e.what(),
@@ -149,13 +198,14 @@ SdfGrid SdfGrid::read(const std::filesystem::path& path) {
     openvdb::io::File file(path.string());
     file.open();
     openvdb::GridBase::Ptr base = file.readGrid("sdf");
-    file.close();
     out.impl_->grid = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
+    out.impl_->closest = openvdb::gridPtrCast<openvdb::Int32Grid>(file.readGrid("closest_triangle"));
+    file.close();
   } catch (const openvdb::Exception& e) {
     throw diefill::InputError(path.string(), "sdf", std::string("not a readable SDF grid: ") + e.what(),
                               "Rebuild it with `diefill sdf`");
   }
-  if (!out.impl_->grid)
+  if (!out.impl_->grid || !out.impl_->closest)
     throw diefill::InputError(path.string(), "sdf", "the grid is not a float grid",
                               "Rebuild it with `diefill sdf`");
   for (auto it = out.impl_->grid->beginMeta(); it != out.impl_->grid->endMeta(); ++it)
@@ -171,9 +221,11 @@ SdfGrid build_sdf(const TriMesh& solid, const SdfOptions& options) {
   TriMeshAdapter adapter{solid, 1.0 / h};
   const int flags = openvdb::tools::DISABLE_RENORMALIZATION;
   SdfGrid out;
+  out.impl_->closest = openvdb::Int32Grid::create(-1);
+  out.impl_->closest->setTransform(transform);
   out.impl_->grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
       adapter, *transform, float(options.exterior_band_m / h), float(options.interior_band_m / h),
-      flags);
+      flags, out.impl_->closest.get());
   out.impl_->grid->setGridClass(openvdb::GRID_LEVEL_SET);
   out.impl_->grid->setName("sdf");
   return out;

@@ -1,5 +1,6 @@
 #include "mesh/verify.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <unordered_map>
@@ -56,41 +57,79 @@ class SegmentProximity {
 
 }  // namespace
 
-SdfVerification verify_sdf(const SdfGrid& sdf, const TriMesh& mesh, const ExactSurface& exact,
+SdfVerification verify_sdf(const WallField& field, const TriMesh& mesh, const ExactSurface& exact,
                            std::size_t samples, std::uint64_t seed, double sharp_angle_deg) {
   SdfVerification out;
-  const double h = sdf.voxel_size();
-  const std::vector<Vec3> voxels = sdf.active_voxel_positions();
-  if (voxels.empty() || samples == 0) return out;
+  const double h = field.voxel;
+  // Band voxels (those with a closest triangle), drawn uniformly without listing them all:
+  // a running count per brick, then the n-th band voxel inside the brick found.
+  struct BrickCount {
+    std::array<int, 3> origin;  // first voxel of the brick
+    std::int32_t brick;
+  };
+  std::vector<BrickCount> bricks;
+  std::vector<std::size_t> running;  // band voxels in bricks before and including this one
+  std::size_t total = 0;
+  for (int bi = 0; bi < field.brick_count[0]; ++bi)
+    for (int bj = 0; bj < field.brick_count[1]; ++bj)
+      for (int bk = 0; bk < field.brick_count[2]; ++bk) {
+        const std::int32_t brick =
+            field.brick_of_cell[(std::size_t(bi) * std::size_t(field.brick_count[1]) + std::size_t(bj)) *
+                                    std::size_t(field.brick_count[2]) + std::size_t(bk)];
+        if (brick < 0) continue;
+        std::size_t in_band = 0;
+        for (std::size_t n = 0; n < 512; ++n) in_band += field.closest[std::size_t(brick) * 512 + n] >= 0;
+        if (in_band == 0) continue;
+        total += in_band;
+        bricks.push_back({{(field.brick_min[0] + bi) * 8, (field.brick_min[1] + bj) * 8,
+                           (field.brick_min[2] + bk) * 8},
+                          brick});
+        running.push_back(total);
+      }
+  auto band_voxel = [&](std::size_t index) {
+    const std::size_t b = std::size_t(std::upper_bound(running.begin(), running.end(), index) - running.begin());
+    std::size_t skip = index - (b == 0 ? 0 : running[b - 1]);
+    for (std::size_t n = 0; n < 512; ++n)
+      if (field.closest[std::size_t(bricks[b].brick) * 512 + n] >= 0 && skip-- == 0)
+        return Vec3(h * (bricks[b].origin[0] + int(n >> 6)), h * (bricks[b].origin[1] + int(n >> 3 & 7)),
+                    h * (bricks[b].origin[2] + int(n & 7)));
+    return Vec3(Vec3::Zero());
+  };
+  if (total == 0 || samples == 0) return out;
   SegmentProximity sharp(sharp_edges(mesh, sharp_angle_deg), h);
   std::mt19937_64 rng(seed);
-  std::uniform_int_distribution<std::size_t> pick(0, voxels.size() - 1);
+  std::uniform_int_distribution<std::size_t> pick(0, total - 1);
   std::uniform_real_distribution<double> offset(0.0, 1.0);
-  double error_sum = 0.0;
-  // Rejection sampling: a uniform voxel, a uniform point in the cell above it, kept when all
-  // eight corners are in the band. Bounded so that a degenerate band cannot loop forever.
+  double query_sum = 0.0, grid_sum = 0.0;
+  auto record = [&](SdfErrors& e, double value, double reference, bool smooth, const Vec3& p,
+                    double& sum) {
+    const double error = std::abs(value - reference) / h;
+    sum += error;
+    e.max_voxels = std::max(e.max_voxels, error);
+    if (smooth && error > e.max_smooth_voxels) {
+      e.max_smooth_voxels = error;
+      e.worst_smooth_point = p;
+    }
+    if (std::abs(reference) > 0.5 * h && (value < 0) != (reference < 0)) ++e.sign_disagreements;
+  };
+  // Rejection sampling: a uniform band voxel, a uniform point in the cell above it, kept when
+  // all eight corners of that cell are in the band. Bounded attempts.
   for (std::size_t attempt = 0; out.samples < samples && attempt < 50 * samples; ++attempt) {
-    const Vec3 p = voxels[pick(rng)] + h * Vec3(offset(rng), offset(rng), offset(rng));
-    if (!sdf.in_band(p)) continue;
+    const Vec3 p = band_voxel(pick(rng)) + h * Vec3(offset(rng), offset(rng), offset(rng));
+    if (!field.band_cell(p)) continue;
+    const double grid_value = field.trilinear(p);
     ++out.samples;
     const double reference = exact.signed_distance(p);
-    const double value = sdf.sample(p);
-    const double error = std::abs(value - reference) / h;
-    error_sum += error;
-    out.max_error_voxels = std::max(out.max_error_voxels, error);
-    if (!sharp.near(p)) {
-      ++out.smooth_samples;
-      if (error > out.max_error_smooth_voxels) {
-        out.max_error_smooth_voxels = error;
-        out.worst_smooth_point = p;
-      }
-    }
-    if (std::abs(reference) > 0.5 * h) {
-      ++out.sign_checked;
-      if ((value < 0) != (reference < 0)) ++out.sign_disagreements;
-    }
+    const bool smooth = !sharp.near(p);
+    out.smooth_samples += smooth;
+    out.sign_checked += std::abs(reference) > 0.5 * h;
+    record(out.query, field.signed_distance(p), reference, smooth, p, query_sum);
+    record(out.grid, grid_value, reference, smooth, p, grid_sum);
   }
-  out.mean_error_voxels = out.samples ? error_sum / out.samples : 0.0;
+  if (out.samples) {
+    out.query.mean_voxels = query_sum / double(out.samples);
+    out.grid.mean_voxels = grid_sum / double(out.samples);
+  }
   return out;
 }
 

@@ -1,0 +1,219 @@
+#include "mesh/wall_field.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace mesh {
+
+ClosestPoint closest_feature(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  // Ericson, Real-Time Collision Detection §5.1.5, keeping track of the Voronoi region.
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return {a, Feature::vertex, 0};
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return {b, Feature::vertex, 1};
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return {a + ab * (d1 / (d1 - d3)), Feature::edge, 0};
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return {c, Feature::vertex, 2};
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return {a + ac * (d2 / (d2 - d6)), Feature::edge, 2};
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return {b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))), Feature::edge, 1};
+  const double denom = 1.0 / (va + vb + vc);
+  return {a + ab * (vb * denom) + ac * (vc * denom), Feature::face, 0};
+}
+
+void WallField::set_surface(const TriMesh& mesh) {
+  vertices = mesh.vertices;
+  triangles = mesh.triangles;
+  const std::size_t nt = triangles.size(), nv = vertices.size();
+  face_normals.resize(nt);
+  neighbours.assign(nt, {-1, -1, -1});
+  vertex_normals.assign(nv, Vec3::Zero());
+  std::map<std::pair<int, int>, std::pair<int, int>> edge_owner;  // directed edge -> (face, k)
+  std::vector<int> degree(nv, 0);
+  for (std::size_t t = 0; t < nt; ++t) {
+    const Triangle& tri = triangles[t];
+    const Vec3 n = (vertices[tri[1]] - vertices[tri[0]]).cross(vertices[tri[2]] - vertices[tri[0]]);
+    face_normals[t] = n.norm() > 0 ? Vec3(n.normalized()) : Vec3::UnitZ();
+    for (int k = 0; k < 3; ++k) {
+      edge_owner[{tri[k], tri[(k + 1) % 3]}] = {int(t), k};
+      ++degree[tri[k]];
+      // Angle-weighted vertex pseudo-normal.
+      const Vec3 e1 = (vertices[tri[(k + 1) % 3]] - vertices[tri[k]]).normalized();
+      const Vec3 e2 = (vertices[tri[(k + 2) % 3]] - vertices[tri[k]]).normalized();
+      vertex_normals[tri[k]] += std::acos(std::clamp(e1.dot(e2), -1.0, 1.0)) * face_normals[t];
+    }
+  }
+  for (std::size_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) {
+      auto it = edge_owner.find({triangles[t][(k + 1) % 3], triangles[t][k]});
+      if (it != edge_owner.end()) neighbours[t][k] = it->second.first;
+    }
+  for (Vec3& n : vertex_normals)
+    if (n.norm() > 0) n.normalize();
+  vertex_face_offsets.assign(nv + 1, 0);
+  for (std::size_t v = 0; v < nv; ++v) vertex_face_offsets[v + 1] = vertex_face_offsets[v] + degree[v];
+  vertex_faces.assign(std::size_t(vertex_face_offsets[nv]), 0);
+  std::vector<int> fill(vertex_face_offsets.begin(), vertex_face_offsets.end() - 1);
+  for (std::size_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) vertex_faces[std::size_t(fill[triangles[t][k]]++)] = int(t);
+}
+
+std::size_t WallField::memory_bytes() const {
+  return vertices.size() * sizeof(Vec3) * 2 + triangles.size() * (sizeof(Triangle) * 2 + sizeof(Vec3)) +
+         vertex_faces.size() * sizeof(int) + brick_of_cell.size() * 4 + distance.size() * 4 +
+         closest.size() * 4;
+}
+
+bool WallField::voxel_at(int i, int j, int k, float& value, std::int32_t& triangle) const {
+  const int bi = (i >> 3) - brick_min[0], bj = (j >> 3) - brick_min[1], bk = (k >> 3) - brick_min[2];
+  triangle = -1;
+  if (bi < 0 || bj < 0 || bk < 0 || bi >= brick_count[0] || bj >= brick_count[1] ||
+      bk >= brick_count[2]) {
+    value = background;
+    return false;
+  }
+  const std::int32_t brick =
+      brick_of_cell[(std::size_t(bi) * std::size_t(brick_count[1]) + std::size_t(bj)) *
+                        std::size_t(brick_count[2]) + std::size_t(bk)];
+  if (brick < 0) {
+    value = brick == -2 ? -background : background;
+    return false;
+  }
+  const std::size_t n = std::size_t(brick) * 512 + std::size_t(((i & 7) * 8 + (j & 7)) * 8 + (k & 7));
+  value = distance[n];
+  triangle = closest[n];
+  return triangle >= 0;
+}
+
+bool WallField::band_cell(const Vec3& p) const {
+  const Vec3 lower = (p / voxel).array().floor();
+  for (int c = 0; c < 8; ++c) {
+    float v;
+    std::int32_t t;
+    if (!voxel_at(int(lower.x()) + (c >> 2 & 1), int(lower.y()) + (c >> 1 & 1),
+                  int(lower.z()) + (c & 1), v, t))
+      return false;
+  }
+  return true;
+}
+
+double WallField::trilinear(const Vec3& p) const {
+  const Vec3 x = p / voxel;
+  const Vec3 lower = x.array().floor();
+  const Vec3 f = x - lower;
+  const int i = int(lower.x()), j = int(lower.y()), k = int(lower.z());
+  double value = 0.0;
+  for (int c = 0; c < 8; ++c) {
+    const int di = c >> 2 & 1, dj = c >> 1 & 1, dk = c & 1;
+    float v;
+    std::int32_t t;
+    voxel_at(i + di, j + dj, k + dk, v, t);
+    value += (di ? f.x() : 1 - f.x()) * (dj ? f.y() : 1 - f.y()) * (dk ? f.z() : 1 - f.z()) * v;
+  }
+  return value;
+}
+
+SurfacePoint WallField::descend(const Vec3& p, int start) const {
+  auto closest_on = [&](int t) {
+    const Triangle& tri = triangles[std::size_t(t)];
+    return closest_feature(p, vertices[tri[0]], vertices[tri[1]], vertices[tri[2]]);
+  };
+  int current = start;
+  ClosestPoint cp = closest_on(current);
+  double d2 = (p - cp.point).squaredNorm();
+  // Walk to a neighbouring triangle while it is strictly closer: a few steps at most, since the
+  // start is the closest triangle of a voxel corner within a voxel of p.
+  for (int step = 0; step < 64 && cp.feature != Feature::face; ++step) {
+    int best = -1;
+    ClosestPoint best_cp = cp;
+    double best_d2 = d2 * (1.0 - 1e-12);
+    auto consider = [&](int t) {
+      if (t < 0 || t == current) return;
+      const ClosestPoint c = closest_on(t);
+      const double e2 = (p - c.point).squaredNorm();
+      if (e2 < best_d2) best = t, best_cp = c, best_d2 = e2;
+    };
+    if (cp.feature == Feature::edge) {
+      consider(neighbours[std::size_t(current)][std::size_t(cp.index)]);
+    } else {
+      const int v = triangles[std::size_t(current)][std::size_t(cp.index)];
+      for (int n = vertex_face_offsets[std::size_t(v)]; n < vertex_face_offsets[std::size_t(v) + 1]; ++n)
+        consider(vertex_faces[std::size_t(n)]);
+    }
+    if (best < 0) break;
+    current = best;
+    cp = best_cp;
+    d2 = (p - cp.point).squaredNorm();
+  }
+
+  const Triangle& tri = triangles[std::size_t(current)];
+  SurfacePoint out;
+  out.point = cp.point;
+  out.triangle = current;
+  Vec3 pseudo_normal = face_normals[std::size_t(current)];
+  switch (cp.feature) {
+    case Feature::face:
+      out.feature = std::uint64_t(current);
+      break;
+    case Feature::edge: {
+      const int a = tri[std::size_t(cp.index)], b = tri[std::size_t(cp.index + 1) % 3];
+      out.feature = (1ull << 62) | (std::uint64_t(std::min(a, b)) << 31) | std::uint64_t(std::max(a, b));
+      const int n = neighbours[std::size_t(current)][std::size_t(cp.index)];
+      if (n >= 0) pseudo_normal += face_normals[std::size_t(n)];
+      break;
+    }
+    case Feature::vertex: {
+      const int v = tri[std::size_t(cp.index)];
+      out.feature = (2ull << 62) | std::uint64_t(v);
+      pseudo_normal = vertex_normals[std::size_t(v)];
+      break;
+    }
+  }
+  const Vec3 diff = p - cp.point;
+  const double length = diff.norm();
+  const double sign = diff.dot(pseudo_normal) >= 0 ? 1.0 : -1.0;
+  out.distance = sign * length;
+  out.normal = length > 1e-12 * voxel ? Vec3(sign * diff / length) : Vec3(pseudo_normal.normalized());
+  return out;
+}
+
+int WallField::local_minima(const Vec3& p, double range, SurfacePoint* out, int capacity) const {
+  const Vec3 x = p / voxel;
+  const int i = int(std::floor(x.x())), j = int(std::floor(x.y())), k = int(std::floor(x.z()));
+  std::int32_t candidates[8];
+  int count = 0;
+  for (int c = 0; c < 8; ++c) {
+    float v;
+    std::int32_t t;
+    if (!voxel_at(i + (c >> 2 & 1), j + (c >> 1 & 1), k + (c & 1), v, t)) continue;
+    if (std::find(candidates, candidates + count, t) == candidates + count) candidates[count++] = t;
+  }
+  int found = 0;
+  for (int c = 0; c < count; ++c) {
+    const SurfacePoint s = descend(p, candidates[c]);
+    if (s.distance > range) continue;
+    bool duplicate = false;
+    for (int f = 0; f < found && !duplicate; ++f) duplicate = out[f].feature == s.feature;
+    if (!duplicate && found < capacity) out[found++] = s;
+  }
+  return found;
+}
+
+double WallField::signed_distance(const Vec3& p) const {
+  SurfacePoint minima[8];
+  const int n = local_minima(p, std::numeric_limits<double>::infinity(), minima, 8);
+  if (n == 0) return trilinear(p);
+  const SurfacePoint* best = &minima[0];
+  for (int m = 1; m < n; ++m)
+    if (std::abs(minima[m].distance) < std::abs(best->distance)) best = &minima[m];
+  return best->distance;
+}
+
+}  // namespace mesh

@@ -1,0 +1,80 @@
+#pragma once
+// The wall representation the simulation queries: a sparse voxel grid (exported from the
+// OpenVDB narrow band) holding, per voxel, the signed distance and the index of the closest
+// triangle, plus the triangle surface with its adjacency. Plain arrays, no OpenVDB types.
+//
+// Why both: trilinear interpolation of any exact distance field is wrong by up to about a
+// quarter voxel on the medial surface of concave edges (the distance has a kink there), and a
+// single nearest distance feels only one face of a concave corner. So a query takes the closest
+// triangles stored at the eight corners of the voxel cell around a point as candidates, walks
+// each down to a local minimum of the distance over the surface, and returns every distinct
+// minimum: exact distances, one contact per face of a concave corner, one (not two) at a convex
+// edge. The cost depends on the voxel lookup and a few triangle tests, not on the mesh's size.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "mesh/trimesh.hpp"
+
+namespace mesh {
+
+// Where on a triangle a closest point lies.
+enum class Feature : std::uint8_t { face, edge, vertex };
+
+struct ClosestPoint {
+  Vec3 point;
+  Feature feature;
+  int index;  // face: the triangle; edge: local edge k (v_k to v_k+1); vertex: local vertex k
+};
+// Closest point to p on triangle abc with the feature it lies on.
+ClosestPoint closest_feature(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+
+struct SurfacePoint {
+  Vec3 point;            // closest point on the surface [m]
+  Vec3 normal;           // unit, from the surface towards the query point (outward if on it)
+  double distance;       // signed [m]: negative when the query point is inside the solid
+  int triangle;          // a triangle the point lies on
+  std::uint64_t feature; // identifies the face, edge or vertex, for merging duplicates
+};
+
+struct WallField {
+  // Surface (metres), with adjacency for the local descent and angle-weighted pseudo-normals
+  // for the sign (Bærentzen & Aanæs 2005).
+  std::vector<Vec3> vertices;
+  std::vector<Triangle> triangles;
+  std::vector<Vec3> face_normals;
+  std::vector<std::array<int, 3>> neighbours;  // across local edge k; -1 on a boundary
+  std::vector<Vec3> vertex_normals;            // angle-weighted
+  std::vector<int> vertex_face_offsets;        // CSR: faces around each vertex
+  std::vector<int> vertex_faces;
+
+  // Sparse voxels: bricks of 8x8x8 voxels; voxel (i, j, k) sits at (i, j, k) * voxel.
+  double voxel = 0.0;                    // [m]
+  float background = 0.0f;               // |distance| reported beyond the band [m]
+  std::array<int, 3> brick_min{}, brick_count{};  // dense brick index box, in bricks
+  std::vector<std::int32_t> brick_of_cell;  // >= 0: brick; -1: no brick, outside; -2: inside
+  std::vector<float> distance;           // 512 per brick [m]
+  std::vector<std::int32_t> closest;     // 512 per brick; -1 where the voxel is not in the band
+
+  std::size_t memory_bytes() const;
+
+  // True when all eight voxels around p are in the band.
+  bool band_cell(const Vec3& p) const;
+  // Trilinear signed distance [m] (± background beyond the band).
+  double trilinear(const Vec3& p) const;
+  // Exact signed distance to the surface near p (within the band), from the local minima;
+  // falls back to trilinear() beyond the band.
+  double signed_distance(const Vec3& p) const;
+  // Every distinct local minimum of the distance to the surface within `range` of p, written
+  // to `out` (at most `capacity`); returns how many were found.
+  int local_minima(const Vec3& p, double range, SurfacePoint* out, int capacity) const;
+
+  // Builds the surface half (adjacency, normals) from a closed, outward mesh.
+  void set_surface(const TriMesh& mesh);
+
+ private:
+  bool voxel_at(int i, int j, int k, float& value, std::int32_t& triangle) const;
+  SurfacePoint descend(const Vec3& p, int triangle) const;
+};
+
+}  // namespace mesh
