@@ -28,8 +28,9 @@ int run_sdf(const SdfCommand& c) {
   } else {
     fmt::print("repair:\n");
     for (const std::string& a : die.actions) fmt::print("  - {}\n", a);
-    fmt::print("  largest deviation introduced: {:.4g} mm (tolerance {:.4g} mm)\n",
-               die.hausdorff_m / mm, options.repair.tolerance_m / mm);
+    fmt::print("  existing surface moved by at most {:.4g} mm (tolerance {:.4g} mm); new surface "
+               "spans gaps up to {:.4g} mm\n",
+               die.hausdorff_m / mm, options.repair.tolerance_m / mm, die.bridged_m / mm);
     fmt::print("after repair:\n{}", mesh::format_report(die.after));
   }
   fmt::print("sdf: role {}, voxel {:.4g} mm, band {:.4g} mm outside / {:.4g} mm inside, "

@@ -27,6 +27,13 @@ struct SdfCommand {
 };
 int run_sdf(const SdfCommand& command);
 
+struct RunCommand {
+  std::filesystem::path target;  // a die mesh or a folder of them
+  std::filesystem::path out = "out";
+  std::string units = "mm";
+};
+int run_pipeline(const RunCommand& command);
+
 struct DieCommand {
   std::string name;  // bundled die
   std::filesystem::path output;

@@ -26,6 +26,14 @@ void add_sdf(CLI::App& root, app::SdfCommand& c, std::function<int()>& action) {
   cmd->callback([&] { action = [&] { return app::run_sdf(c); }; });
 }
 
+void add_run(CLI::App& root, app::RunCommand& c, std::function<int()>& action) {
+  CLI::App* cmd = root.add_subcommand("run", "The whole pipeline on a die mesh or on every mesh of a folder");
+  cmd->add_option("TARGET", c.target, "Die mesh or folder of meshes")->required();
+  cmd->add_option("--out", c.out, "Output folder; each die writes into OUT/<die name>/")->capture_default_str();
+  cmd->add_option("--units", c.units, "Length unit of the meshes: mm, m or in")->capture_default_str();
+  cmd->callback([&] { action = [&] { return app::run_pipeline(c); }; });
+}
+
 void add_die(CLI::App& root, app::DieCommand& c, std::function<int()>& action) {
   CLI::App* cmd = root.add_subcommand("die", "Write a bundled die mesh (ring, disc) as binary STL in mm");
   cmd->add_option("NAME", c.name, "ring or disc")->required();
@@ -47,6 +55,8 @@ int main(int argc, char** argv) {
   std::function<int()> action;
   app::SdfCommand sdf;
   app::DieCommand die;
+  app::RunCommand run;
+  add_run(root, run, action);
   add_sdf(root, sdf, action);
   add_die(root, die, action);
   try {

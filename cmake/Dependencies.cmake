@@ -3,6 +3,7 @@
 list(APPEND CMAKE_MODULE_PATH "/usr/lib/${CMAKE_LIBRARY_ARCHITECTURE}/cmake/OpenVDB")
 
 find_package(Threads REQUIRED)
+find_package(OpenMP REQUIRED)
 find_package(TBB REQUIRED)
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 find_package(CGAL 5.5 REQUIRED)

@@ -9,8 +9,8 @@ namespace mesh::detail {
 // outward surface at distance `offset` outside the input, bridging gaps narrower than `alpha`.
 TriMesh alpha_wrap(const TriMesh& soup, double alpha, double offset);
 
-// Largest distance from points sampled on `from` (vertices, edge midpoints, centroids) to the
-// surface of `to` [m]: one side of the Hausdorff distance.
+// Largest distance from points sampled on `from` (a barycentric grid on each triangle, up to
+// 16 points along an edge) to the surface of `to` [m]: one side of the Hausdorff distance.
 double max_distance(const TriMesh& from, const TriMesh& to);
 
 // Pairs of intersecting triangles that share no vertex; 0 for a clean mesh.

@@ -20,7 +20,7 @@ using nlohmann::json;
 namespace {
 
 // Bumped whenever the mesh stage's output for the same inputs changes.
-constexpr int cache_format = 1;
+constexpr int cache_format = 2;
 
 json report_json(const MeshReport& r) {
   return {{"triangles", r.triangles},
@@ -161,6 +161,7 @@ PreparedDie prepare_die(const fs::path& path, const DieOptions& options,
           out.actions = meta.at("actions").get<std::vector<std::string>>();
           out.wrapped = meta.at("wrapped");
           out.hausdorff_m = meta.at("hausdorff_m");
+          out.bridged_m = meta.at("bridged_m");
           out.table_z = meta.at("table_z");
           out.cavity = std::move(*cavity);
           out.solid = std::move(*solid);
@@ -180,6 +181,7 @@ PreparedDie prepare_die(const fs::path& path, const DieOptions& options,
   out.actions = repaired.actions;
   out.wrapped = repaired.wrapped;
   out.hausdorff_m = repaired.hausdorff_m;
+  out.bridged_m = repaired.bridged_m;
   out.cavity = std::move(repaired.mesh);
 
   const double extent = out.after.bbox.size().maxCoeff();
@@ -222,6 +224,7 @@ PreparedDie prepare_die(const fs::path& path, const DieOptions& options,
                        {"actions", out.actions},
                        {"wrapped", out.wrapped},
                        {"hausdorff_m", out.hausdorff_m},
+                       {"bridged_m", out.bridged_m},
                        {"table_z", out.table_z}};
     diefill::write_file_atomic(base.string() + ".json", meta.dump(2));
   }

@@ -41,7 +41,8 @@ struct PreparedDie {
   MeshReport before, after;          // checks before and after repair
   std::vector<std::string> actions;  // repair steps taken
   bool wrapped = false;
-  double hausdorff_m = 0.0;
+  double hausdorff_m = 0.0;   // existing surface moved by repair [m]
+  double bridged_m = 0.0;     // widest gap new surface spans [m]
   TriMesh cavity;      // repaired mesh as given (the cavity, or the tool for role = tool) [m]
   TriMesh solid;       // what the powder meets: tool for role = cavity, else the mesh itself
   double table_z = 0.0;

@@ -38,13 +38,19 @@ void check_readable_file(const fs::path& path) {
   if (!probe) throw InputError(path.string(), "", "cannot be read", "Check the file's permissions");
 }
 
-void append_node_meshes(const aiScene& scene, ImportResult& result) {
+// Every mesh instance of the node hierarchy, in the file's world frame: several solids or
+// objects in one file become one triangle mesh.
+void append_node_meshes(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent,
+                        ImportResult& result) {
+  const aiMatrix4x4 transform = parent * node.mTransformation;
   TriMesh& out = result.mesh;
-  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
-    const aiMesh& in = *scene.mMeshes[m];
+  for (unsigned n = 0; n < node.mNumMeshes; ++n) {
+    const aiMesh& in = *scene.mMeshes[node.mMeshes[n]];
     const int base = int(out.vertices.size());
-    for (unsigned v = 0; v < in.mNumVertices; ++v)
-      out.vertices.emplace_back(in.mVertices[v].x, in.mVertices[v].y, in.mVertices[v].z);
+    for (unsigned v = 0; v < in.mNumVertices; ++v) {
+      const aiVector3D p = transform * in.mVertices[v];
+      out.vertices.emplace_back(p.x, p.y, p.z);
+    }
     result.vertices_read += in.mNumVertices;
     for (unsigned f = 0; f < in.mNumFaces; ++f) {
       const aiFace& face = in.mFaces[f];
@@ -55,8 +61,10 @@ void append_node_meshes(const aiScene& scene, ImportResult& result) {
       out.triangles.push_back({base + int(face.mIndices[0]), base + int(face.mIndices[1]),
                                base + int(face.mIndices[2])});
     }
+    ++result.meshes_joined;
   }
-  result.meshes_joined = int(scene.mNumMeshes);
+  for (unsigned c = 0; c < node.mNumChildren; ++c)
+    append_node_meshes(scene, *node.mChildren[c], transform, result);
 }
 
 }  // namespace
@@ -104,8 +112,7 @@ ImportResult import_mesh(const fs::path& path, const ImportOptions& options) {
   Assimp::Importer importer;
   // Lines and points are removed by assimp itself; they cannot bound a solid.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const unsigned flags = aiProcess_Triangulate | aiProcess_PreTransformVertices |
-                         aiProcess_SortByPType | aiProcess_ValidateDataStructure;
+  const unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_ValidateDataStructure;
   const aiScene* scene = importer.ReadFile(path.string(), flags);
   if (scene == nullptr)
     throw InputError(path.string(), "", std::string("not a readable mesh (assimp: ") +
@@ -114,7 +121,7 @@ ImportResult import_mesh(const fs::path& path, const ImportOptions& options) {
 
   ImportResult result;
   result.format = path.extension().string();
-  append_node_meshes(*scene, result);
+  if (scene->mRootNode != nullptr) append_node_meshes(*scene, *scene->mRootNode, aiMatrix4x4(), result);
   if (result.mesh.triangles.empty())
     throw InputError(path.string(), "triangles", "the file holds no triangles",
                      "Export the solid as a surface mesh");

@@ -335,11 +335,17 @@ RepairResult repair(const TriMesh& input, const RepairOptions& options, const st
         parts.push_back(fmt::format("{} pairs of intersecting triangles", crossing));
       if (!parts.empty()) defect += " (" + fmt::format("{}", fmt::join(parts, "; ")) + ")";
     }
+    const double alpha = 2.0 * options.tolerance_m;
+    const double offset = 0.25 * options.tolerance_m;
+    // A hole wider than the wrapping ball lets the wrap inside: it would return a thin sheet.
+    if (!closed && largest_open_hole > 2.0 * alpha)
+      throw InputError(source, "boundary edges",
+                       defect + fmt::format("; holes larger than {} are not filled",
+                                            mm(options.max_hole_m)),
+                       "Close the mesh in CAD, or raise the largest hole to fill (--max-hole)");
     if (!options.allow_wrap)
       throw InputError(source, "surface", defect,
                        "Repair the mesh in CAD, or allow the alpha-wrap fallback");
-    const double alpha = 2.0 * options.tolerance_m;
-    const double offset = 0.25 * options.tolerance_m;
     // A wrap has about 2 A / alpha² triangles; beyond a few million it takes many minutes.
     const double expected_triangles = 2.0 * before.area_m2 / (alpha * alpha);
     if (expected_triangles > max_wrap_triangles)
@@ -367,8 +373,8 @@ RepairResult repair(const TriMesh& input, const RepairOptions& options, const st
 
   diefill::log::debug("repair: closed-surface checks done at {:.2f} s", clock.seconds());
   if (geometry_changed) {
-    result.hausdorff_m = std::max(detail::max_distance(input, repaired),
-                                  detail::max_distance(repaired, input));
+    result.hausdorff_m = detail::max_distance(input, repaired);
+    result.bridged_m = detail::max_distance(repaired, input);
     if (result.hausdorff_m > options.tolerance_m)
       throw InputError(source, "tolerance",
                        fmt::format("repair would move the surface by up to {} ({}), more than the "

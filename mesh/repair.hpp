@@ -42,7 +42,12 @@ struct RepairResult {
   bool repaired = false;             // anything changed at all
   bool wrapped = false;              // alpha wrapping was used
   std::size_t holes_filled = 0;
-  double hausdorff_m = 0.0;          // largest deviation from the input surface introduced
+  // Largest distance from the input surface to the result [m]: how far repair moved existing
+  // geometry; checked against the tolerance.
+  double hausdorff_m = 0.0;
+  // Largest distance from the result to the input surface [m]: how wide a gap (hole, crack,
+  // groove) new surface spans; reported, not bounded, since no input geometry exists there.
+  double bridged_m = 0.0;
 };
 
 // Repairs `mesh` or throws diefill::InputError naming `source` and the defect that could not

@@ -184,36 +184,61 @@ SurfacePoint WallField::descend(const Vec3& p, int start) const {
   return out;
 }
 
-int WallField::local_minima(const Vec3& p, double range, SurfacePoint* out, int capacity) const {
+int WallField::candidates(const Vec3& p, int reach, std::int32_t* out, int capacity) const {
   const Vec3 x = p / voxel;
-  const int i = int(std::floor(x.x())), j = int(std::floor(x.y())), k = int(std::floor(x.z()));
-  std::int32_t candidates[8];
+  // reach 0: the cell's corners [i, i+1]; reach 1: [n-1, n+1] around the nearest voxel n.
+  const Vec3 base = reach == 0 ? Vec3(x.array().floor()) : Vec3(x.array().round());
+  const int i = int(base.x()), j = int(base.y()), k = int(base.z());
+  const int lo = reach == 0 ? 0 : -1, hi = 1;
   int count = 0;
-  for (int c = 0; c < 8; ++c) {
-    float v;
-    std::int32_t t;
-    if (!voxel_at(i + (c >> 2 & 1), j + (c >> 1 & 1), k + (c & 1), v, t)) continue;
-    if (std::find(candidates, candidates + count, t) == candidates + count) candidates[count++] = t;
-  }
+  for (int di = lo; di <= hi; ++di)
+    for (int dj = lo; dj <= hi; ++dj)
+      for (int dk = lo; dk <= hi; ++dk) {
+        float v;
+        std::int32_t t;
+        if (!voxel_at(i + di, j + dj, k + dk, v, t)) continue;
+        if (count < capacity && std::find(out, out + count, t) == out + count) out[count++] = t;
+      }
+  return count;
+}
+
+int WallField::local_minima(const Vec3& p, double range, SurfacePoint* out, int capacity) const {
+  std::int32_t triangles_near[8];
+  const int count = candidates(p, 0, triangles_near, 8);
+  // Minima with nearly parallel normals lie on one smooth surface: a tessellated curve seen
+  // from its concave side has a minimum on each facet near a facet edge, and counting both
+  // would double the force there. Only the deepest of them is a contact; minima whose normals
+  // differ by more than `smooth_angle` (a concave corner) are contacts each.
+  const double same_surface = std::cos(smooth_angle_deg * 3.14159265358979323846 / 180.0);
   int found = 0;
   for (int c = 0; c < count; ++c) {
-    const SurfacePoint s = descend(p, candidates[c]);
+    const SurfacePoint s = descend(p, triangles_near[c]);
     if (s.distance > range) continue;
-    bool duplicate = false;
-    for (int f = 0; f < found && !duplicate; ++f) duplicate = out[f].feature == s.feature;
-    if (!duplicate && found < capacity) out[found++] = s;
+    int merged = -1;
+    for (int f = 0; f < found && merged < 0; ++f)
+      if (out[f].feature == s.feature || out[f].normal.dot(s.normal) > same_surface) merged = f;
+    if (merged >= 0) {
+      if (s.distance < out[merged].distance) out[merged] = s;
+    } else if (found < capacity) {
+      out[found++] = s;
+    }
   }
   return found;
 }
 
+bool WallField::nearest(const Vec3& p, int reach, SurfacePoint& out) const {
+  std::int32_t triangles_near[27];
+  const int count = candidates(p, reach, triangles_near, 27);
+  for (int c = 0; c < count; ++c) {
+    const SurfacePoint s = descend(p, triangles_near[c]);
+    if (c == 0 || std::abs(s.distance) < std::abs(out.distance)) out = s;
+  }
+  return count > 0;
+}
+
 double WallField::signed_distance(const Vec3& p) const {
-  SurfacePoint minima[8];
-  const int n = local_minima(p, std::numeric_limits<double>::infinity(), minima, 8);
-  if (n == 0) return trilinear(p);
-  const SurfacePoint* best = &minima[0];
-  for (int m = 1; m < n; ++m)
-    if (std::abs(minima[m].distance) < std::abs(best->distance)) best = &minima[m];
-  return best->distance;
+  SurfacePoint best;
+  return nearest(p, 0, best) ? best.distance : trilinear(p);
 }
 
 }  // namespace mesh

@@ -37,6 +37,10 @@ struct SurfacePoint {
   std::uint64_t feature; // identifies the face, edge or vertex, for merging duplicates
 };
 
+// Contact normals closer than this belong to one smooth surface (the sharp-edge angle of
+// mesh::sharp_edges uses the same figure).
+inline constexpr double smooth_angle_deg = 30.0;
+
 struct WallField {
   // Surface (metres), with adjacency for the local descent and angle-weighted pseudo-normals
   // for the sign (Bærentzen & Aanæs 2005).
@@ -66,14 +70,21 @@ struct WallField {
   // falls back to trilinear() beyond the band.
   double signed_distance(const Vec3& p) const;
   // Every distinct local minimum of the distance to the surface within `range` of p, written
-  // to `out` (at most `capacity`); returns how many were found.
+  // to `out` (at most `capacity`); returns how many were found. Minima on one smooth surface
+  // (normals within smooth_angle_deg) count once, at the deepest.
   int local_minima(const Vec3& p, double range, SurfacePoint* out, int capacity) const;
+  // The closest surface point found from the candidates of the voxels around p: the cell's 8
+  // corners (reach 0), or the 3x3x3 voxels centred on the voxel nearest to p (reach 1, for
+  // grid nodes). False beyond the band.
+  bool nearest(const Vec3& p, int reach, SurfacePoint& out) const;
 
   // Builds the surface half (adjacency, normals) from a closed, outward mesh.
   void set_surface(const TriMesh& mesh);
 
  private:
   bool voxel_at(int i, int j, int k, float& value, std::int32_t& triangle) const;
+  // Distinct closest triangles of the voxels around p (see nearest); returns their number.
+  int candidates(const Vec3& p, int reach, std::int32_t* out, int capacity) const;
   SurfacePoint descend(const Vec3& p, int triangle) const;
 };
 

@@ -6,7 +6,9 @@
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/alpha_wrap_3.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <vector>
 
 #include "mesh/cgal_ops.hpp"
@@ -70,15 +72,17 @@ double max_distance(const TriMesh& from, const TriMesh& to) {
   auto probe = [&](const Vec3& p) {
     worst_squared = std::max(worst_squared, tree.squared_distance(to_point(p)));
   };
-  for (const Vec3& v : from.vertices) probe(v);
+  // A barycentric grid on every triangle, about 16 points along its longest edge at most.
+  const double diagonal = bounding_box(from).size().norm();
   for (const Triangle& t : from.triangles) {
     const Vec3& a = from.vertices[t[0]];
     const Vec3& b = from.vertices[t[1]];
     const Vec3& c = from.vertices[t[2]];
-    probe((a + b + c) / 3.0);
-    probe((a + b) / 2.0);
-    probe((b + c) / 2.0);
-    probe((c + a) / 2.0);
+    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    const int k = std::clamp(int(std::ceil(longest / (diagonal * 1e-3))), 1, 16);
+    for (int i = 0; i <= k; ++i)
+      for (int j = 0; i + j <= k; ++j)
+        probe(a + (b - a) * (double(i) / k) + (c - a) * (double(j) / k));
   }
   return std::sqrt(worst_squared);
 }

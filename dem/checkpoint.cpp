@@ -1,0 +1,109 @@
+#include "dem/checkpoint.hpp"
+
+#include <fstream>
+
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+
+namespace dem {
+
+namespace {
+
+constexpr char magic[8] = {'D', 'F', 'C', 'K', 'P', 'T', '0', '1'};
+
+struct Writer {
+  std::string bytes;
+  template <typename T>
+  void value(const T& v) { bytes.append(reinterpret_cast<const char*>(&v), sizeof v); }
+  template <typename T>
+  void array(const std::vector<T>& v) {
+    value(std::uint64_t(v.size()));
+    bytes.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+  }
+};
+
+struct Reader {
+  std::ifstream in;
+  template <typename T>
+  void value(T& v) { in.read(reinterpret_cast<char*>(&v), sizeof v); }
+  template <typename T>
+  void array(std::vector<T>& v) {
+    std::uint64_t n = 0;
+    value(n);
+    if (!in || n > (std::uint64_t(1) << 40) / sizeof(T)) {
+      in.setstate(std::ios::failbit);
+      return;
+    }
+    v.resize(n);
+    in.read(reinterpret_cast<char*>(v.data()), std::streamsize(n * sizeof(T)));
+  }
+};
+
+// One list of every field, used by both directions, so that they cannot drift apart.
+template <typename IO, typename S>
+void fields(IO& io, S& s) {
+  io.array(s.id);
+  io.array(s.x);
+  io.array(s.v);
+  io.array(s.w);
+  io.array(s.f);
+  io.array(s.torque);
+  io.array(s.radius);
+  io.array(s.mass);
+  io.array(s.inertia);
+  io.array(s.material);
+  io.array(s.active);
+  io.array(s.wall_slots);
+  auto& nl = s.neighbours;
+  io.array(nl.row_start);
+  io.array(nl.partner);
+  io.array(nl.history);
+  io.array(nl.reverse_start);
+  io.array(nl.reverse_pair);
+  io.array(nl.near_wall);
+  io.array(nl.x_at_build);
+  io.array(nl.wall_shift_at_build);
+  io.value(nl.builds);
+  auto& pf = s.pair_forces;
+  io.array(pf.force);
+  io.array(pf.moment);
+  io.array(pf.rolling);
+  io.array(pf.arm_i);
+  io.array(pf.arm_j);
+  io.value(s.time);
+  io.value(s.step);
+  io.value(s.lost);
+  io.value(s.wall_work);
+  io.value(s.energy_reference);
+  io.value(s.energy_scale);
+  io.value(s.energy_reference_set);
+}
+
+}  // namespace
+
+void write_checkpoint(const Model& model, const State& state, const std::filesystem::path& path) {
+  Writer w;
+  w.bytes.append(magic, sizeof magic);
+  w.bytes.append(model.hash);
+  fields(w, state);
+  diefill::write_file_atomic(path, w.bytes);
+}
+
+State read_checkpoint(const Model& model, const std::filesystem::path& path) {
+  Reader r{std::ifstream(path, std::ios::binary)};
+  char head[sizeof magic];
+  std::string hash(model.hash.size(), '\0');
+  r.in.read(head, sizeof head);
+  r.in.read(hash.data(), std::streamsize(hash.size()));
+  if (!r.in || std::string(head, sizeof head) != std::string(magic, sizeof magic))
+    throw diefill::InputError(path.string(), "", "not a diefill checkpoint", "Name a checkpoint file diefill wrote");
+  if (hash != model.hash)
+    throw diefill::InputError(path.string(), "model", "the checkpoint was written by a different scene or build",
+                              "Resume with the scene that wrote it, or start afresh");
+  State s;
+  fields(r, s);
+  if (!r.in) throw diefill::InputError(path.string(), "", "the checkpoint is truncated", "Start afresh");
+  return s;
+}
+
+}  // namespace dem

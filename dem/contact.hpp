@@ -1,0 +1,181 @@
+#pragma once
+// Contact laws composed of slots (after LAMMPS GRANULAR): normal (Hertz or linear
+// spring-dashpot, each with viscous damping to a prescribed restitution), tangential (Mindlin
+// spring with history and a Coulomb cap), rolling (elastic-plastic spring or constant
+// directional torque) and cohesion (simplified JKR). Each slot is a small struct with its
+// parameters and a pure function; the force loop is instantiated once per combination in use
+// (forces.cpp), so adding a law never touches the loop. Equations: ../shared/docs/PHYSICS.md §2.
+#include <cmath>
+#include <cstdint>
+
+#include "dem/types.hpp"
+
+namespace dem {
+
+// Parameters of one pair of materials (or a material and a wall), after mixing. SI units.
+struct PairParams {
+  double e_star = 0;       // effective Young's modulus E* [Pa]
+  double g_star = 0;       // effective shear modulus G* [Pa]
+  double restitution = 1;  // prescribed e
+  double damping = 0;      // dimensionless damping ratio, calibrated so the realised e is the prescribed one
+  double mu_s = 0;         // sliding friction
+  double mu_r = 0;         // rolling friction (dimensionless)
+  double k_linear = 0;     // linear normal stiffness [N/m] (linear law)
+  double cohesion = 0;     // SJKR cohesion energy density [J/m³ = N/m²]
+};
+
+enum class NormalLaw : std::uint8_t { hertz, linear };
+enum class TangentialLaw : std::uint8_t { mindlin, none };
+enum class RollingLaw : std::uint8_t { epsd, cdt, none };
+enum class CohesionLaw : std::uint8_t { sjkr, none };
+
+// Geometry and kinematics of one contact, from body i's point of view: n points from j to i.
+struct ContactKinematics {
+  Vec3 n;            // unit normal, from the partner towards body i
+  double overlap;    // δ > 0 [m]
+  double r_eff;      // R* [m]
+  double m_eff;      // m* [kg]
+  Vec3 v_rel;        // velocity of i relative to the partner at the contact point [m/s]
+  Vec3 w_rel;        // angular velocity of i relative to the partner [rad/s] (rolling)
+};
+
+// What a contact carries between steps, per pair.
+struct ContactHistory {
+  Vec3 tangential = Vec3::Zero();  // accumulated tangential displacement ξ [m]
+  Vec3 rolling = Vec3::Zero();     // elastic rolling torque (EPSD) [N m]
+};
+
+struct ContactForce {
+  Vec3 force;           // on body i [N]
+  Vec3 rolling_torque;  // on body i [N m] (the partner gets the opposite)
+  double normal;        // magnitude of the normal force, for monitors [N]
+};
+
+// ---- normal slot ------------------------------------------------------------------------
+// Returns the elastic normal force [N] and the normal stiffness S_n [N/m] at this overlap.
+struct HertzNormal {
+  static void eval(const PairParams& p, const ContactKinematics& c, double& elastic, double& stiffness) {
+    const double a = std::sqrt(c.r_eff * c.overlap);   // contact radius [m]
+    stiffness = 2.0 * p.e_star * a;                    // S_n = 2 E* sqrt(R* δ)
+    elastic = (2.0 / 3.0) * stiffness * c.overlap;     // (4/3) E* sqrt(R*) δ^{3/2}
+  }
+};
+struct LinearNormal {
+  static void eval(const PairParams& p, const ContactKinematics& c, double& elastic, double& stiffness) {
+    stiffness = p.k_linear;
+    elastic = p.k_linear * c.overlap;
+  }
+};
+
+// ---- tangential slot --------------------------------------------------------------------
+struct MindlinTangential {
+  static constexpr bool active = true;
+  // Tangential force on i, updating the spring; `normal_force` is the (non-negative) normal
+  // force the Coulomb cap uses, `gamma_scale` the damping coefficient per sqrt(stiffness).
+  static Vec3 eval(const PairParams& p, const ContactKinematics& c, double normal_force,
+                   double gamma_scale, double dt, Vec3& spring) {
+    const Vec3 vt = c.v_rel - c.n * c.n.dot(c.v_rel);
+    // Keep the spring in the current tangent plane, preserving its length.
+    const double length = spring.norm();
+    spring -= c.n * c.n.dot(spring);
+    const double projected = spring.norm();
+    if (projected > 0) spring *= length / projected;
+    spring += vt * dt;
+    const double kt = 8.0 * p.g_star * std::sqrt(c.r_eff * c.overlap);  // S_t = 8 G* sqrt(R* δ)
+    const double gamma = gamma_scale * std::sqrt(kt * c.m_eff);
+    Vec3 force = -kt * spring - gamma * vt;
+    const double cap = p.mu_s * normal_force;
+    const double magnitude = force.norm();
+    if (magnitude > cap) {
+      // Gross sliding: the force sits on the Coulomb cap and the spring is reset to it.
+      force *= cap / magnitude;
+      spring = kt > 0 ? Vec3(-force / kt) : Vec3(Vec3::Zero());
+    }
+    return force;
+  }
+};
+struct NoTangential {
+  static constexpr bool active = false;
+  static Vec3 eval(const PairParams&, const ContactKinematics&, double, double, double, Vec3&) {
+    return Vec3::Zero();
+  }
+};
+
+// ---- rolling slot -----------------------------------------------------------------------
+// Torque on i opposing the relative rolling; limit μ_r R* F_n.
+struct EpsdRolling {
+  static constexpr bool active = true;
+  // Elastic-plastic spring (Ai et al. 2011, type C without damping): k_r = 2.25 S_n μ_r² R*².
+  static Vec3 eval(const PairParams& p, const ContactKinematics& c, double normal_force,
+                   double normal_stiffness, double dt, Vec3& torque) {
+    const Vec3 w_roll = c.w_rel - c.n * c.n.dot(c.w_rel);
+    const double length = torque.norm();
+    torque -= c.n * c.n.dot(torque);
+    const double projected = torque.norm();
+    if (projected > 0) torque *= length / projected;
+    const double kr = 2.25 * normal_stiffness * p.mu_r * p.mu_r * c.r_eff * c.r_eff;
+    torque -= kr * w_roll * dt;
+    const double cap = p.mu_r * c.r_eff * normal_force;
+    const double magnitude = torque.norm();
+    if (magnitude > cap) torque *= cap / magnitude;
+    return torque;
+  }
+};
+struct CdtRolling {
+  static constexpr bool active = true;
+  // Constant directional torque (LIGGGHTS "cdt"): full limit against the rolling direction.
+  static Vec3 eval(const PairParams& p, const ContactKinematics& c, double normal_force, double,
+                   double, Vec3&) {
+    const Vec3 w_roll = c.w_rel - c.n * c.n.dot(c.w_rel);
+    const double w = w_roll.norm();
+    if (w < 1e-12) return Vec3::Zero();
+    return -(p.mu_r * c.r_eff * normal_force / w) * w_roll;
+  }
+};
+struct NoRolling {
+  static constexpr bool active = false;
+  static Vec3 eval(const PairParams&, const ContactKinematics&, double, double, double, Vec3&) {
+    return Vec3::Zero();
+  }
+};
+
+// ---- cohesion slot ----------------------------------------------------------------------
+// Simplified JKR: an attractive force k A over the Hertzian contact area A = π R* δ.
+struct SjkrCohesion {
+  static double eval(const PairParams& p, const ContactKinematics& c) {
+    return -p.cohesion * 3.14159265358979323846 * c.r_eff * c.overlap;
+  }
+};
+struct NoCohesion {
+  static double eval(const PairParams&, const ContactKinematics&) { return 0.0; }
+};
+
+// The composed law: normal elastic plus damping (never attractive), cohesion, tangential and
+// rolling, in that order.
+template <class Normal, class Tangential, class Rolling, class Cohesion>
+struct ContactLaw {
+  static ContactForce eval(const PairParams& p, const ContactKinematics& c, double dt,
+                           ContactHistory& h) {
+    double elastic, stiffness;
+    Normal::eval(p, c, elastic, stiffness);
+    const double vn = c.n.dot(c.v_rel);  // > 0 when separating
+    const double gamma = p.damping * std::sqrt(stiffness * c.m_eff);
+    // Contact force in the normal direction without cohesion may not pull.
+    const double repulsive = std::max(0.0, elastic - gamma * vn);
+    const double normal = repulsive + Cohesion::eval(p, c);
+    ContactForce out;
+    out.normal = repulsive;
+    out.force = c.n * normal;
+    out.force += Tangential::eval(p, c, repulsive, p.damping, dt, h.tangential);
+    out.rolling_torque = Rolling::eval(p, c, repulsive, stiffness, dt, h.rolling);
+    return out;
+  }
+};
+
+// Damping ratio γ / sqrt(S_n m*) that makes a collision under `law` end with restitution `e`,
+// found by integrating the dimensionless collision (with the no-pull clamp) and bisection.
+double damping_for_restitution(NormalLaw law, double e);
+// The restitution a damping ratio gives (the forward map, exposed for tests).
+double restitution_for_damping(NormalLaw law, double damping);
+
+}  // namespace dem

@@ -1,0 +1,213 @@
+#include "dem/forces.hpp"
+
+#include "dem/walls.hpp"
+
+namespace dem {
+
+namespace {
+
+template <class Law>
+void pair_forces(const Model& model, State& s) {
+  NeighbourList& nl = s.neighbours;
+  PairForces& pf = s.pair_forces;
+  const std::size_t n = s.size();
+  const double dt = model.dt;
+  double max_overlap = 0;
+  std::int64_t contacts = 0;
+#pragma omp parallel for schedule(dynamic, 512) reduction(max : max_overlap) reduction(+ : contacts)
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 xi = s.x[i], vi = s.v[i], wi = s.w[i];
+    const double ri = s.radius[i], mi = s.mass[i];
+    const int mat_i = s.material[i];
+    for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p) {
+      const std::size_t j = std::size_t(nl.partner[std::size_t(p)]);
+      const Vec3 d = xi - s.x[j];
+      const double reach = ri + s.radius[j];
+      const double dist2 = d.squaredNorm();
+      ContactHistory& h = nl.history[std::size_t(p)];
+      if (dist2 >= reach * reach || !s.active[j] || !s.active[i]) {
+        h = ContactHistory{};
+        pf.force[std::size_t(p)].setZero();
+        pf.moment[std::size_t(p)].setZero();
+        pf.rolling[std::size_t(p)].setZero();
+        continue;
+      }
+      const double dist = std::sqrt(dist2);
+      ContactKinematics c;
+      c.n = d / dist;
+      c.overlap = reach - dist;
+      const double rj = s.radius[j], mj = s.mass[j];
+      c.r_eff = ri * rj / reach;
+      c.m_eff = mi * mj / (mi + mj);
+      const double arm_i = ri - 0.5 * c.overlap, arm_j = rj - 0.5 * c.overlap;
+      c.v_rel = vi - wi.cross(arm_i * c.n) - (s.v[j] + s.w[j].cross(arm_j * c.n));
+      c.w_rel = wi - s.w[j];
+      const ContactForce cf = Law::eval(model.params(mat_i, s.material[j]), c, dt, h);
+      pf.force[std::size_t(p)] = cf.force;
+      pf.moment[std::size_t(p)] = c.n.cross(cf.force);
+      pf.rolling[std::size_t(p)] = cf.rolling_torque;
+      pf.arm_i[std::size_t(p)] = arm_i;
+      pf.arm_j[std::size_t(p)] = arm_j;
+      max_overlap = std::max(max_overlap, c.overlap / std::min(ri, rj));
+      ++contacts;
+    }
+  }
+  s.counters.max_overlap_rel = max_overlap;
+  s.counters.contacts = contacts;
+}
+
+template <class Law>
+void wall_forces(const Model& model, State& s) {
+  const std::vector<std::int32_t>& near = s.neighbours.near_wall;
+  const double dt = model.dt;
+  double max_overlap = s.counters.max_overlap_rel;
+  std::int64_t contacts = 0;
+  std::vector<double>& power = s.scratch_wall_power;
+  power.assign(near.size(), 0.0);
+#pragma omp parallel for schedule(dynamic, 256) reduction(max : max_overlap) reduction(+ : contacts)
+  for (std::size_t q = 0; q < near.size(); ++q) {
+    const std::size_t i = std::size_t(near[q]);
+    if (!s.active[i]) continue;
+    WallHit hits[wall_slots_per_particle];
+    const int count = wall_hits(model, s.time, s.x[i], s.radius[i], hits, wall_slots_per_particle);
+    WallSlot* slots = &s.wall_slots[i * wall_slots_per_particle];
+    WallSlot next[wall_slots_per_particle];
+    bool taken[wall_slots_per_particle] = {};
+    for (int k = 0; k < count; ++k) {
+      const WallHit& hit = hits[k];
+      // Recognise last step's contact with the same wall by its normal (a grain rolling over
+      // a tessellated face changes triangles, not contacts).
+      int match = -1;
+      double best = 0.7;
+      for (int o = 0; o < wall_slots_per_particle; ++o)
+        if (!taken[o] && slots[o].wall == hit.wall && slots[o].normal.dot(hit.normal) > best)
+          best = slots[o].normal.dot(hit.normal), match = o;
+      next[k].wall = hit.wall;
+      next[k].normal = hit.normal;
+      if (match >= 0) {
+        taken[match] = true;
+        next[k].history = slots[match].history;
+      }
+      ContactKinematics c;
+      c.n = hit.normal;
+      c.overlap = s.radius[i] - hit.distance;
+      c.r_eff = s.radius[i];
+      c.m_eff = s.mass[i];
+      const double arm = std::max(0.0, hit.distance);
+      c.v_rel = s.v[i] - s.w[i].cross(arm * c.n) - hit.wall_velocity;
+      c.w_rel = s.w[i] - hit.wall_angular_velocity;
+      const int wall_material = hit.wall < std::int32_t(model.planes.size())
+                                    ? model.planes[std::size_t(hit.wall)].material
+                                    : model.meshes[std::size_t(hit.wall) - model.planes.size()].material;
+      const ContactForce cf = Law::eval(model.params(s.material[i], wall_material), c, dt, next[k].history);
+      s.f[i] += cf.force;
+      s.torque[i] += -arm * c.n.cross(cf.force) + cf.rolling_torque;
+      power[q] += cf.force.dot(hit.wall_velocity);
+      max_overlap = std::max(max_overlap, c.overlap / s.radius[i]);
+      ++contacts;
+    }
+    for (int k = 0; k < wall_slots_per_particle; ++k) slots[k] = k < count ? next[k] : WallSlot{};
+  }
+  double total_power = 0;
+  for (double p : power) total_power += p;  // serial: the same sum for any thread count
+  s.counters.wall_power = total_power;
+  s.counters.max_overlap_rel = max_overlap;
+  s.counters.wall_contacts = contacts;
+}
+
+// The laws in use, instantiated once each; the scene's names select one at run time.
+template <template <class> class Stage>
+void dispatch(const Model& m, State& s) {
+  auto with_cohesion = [&](auto normal, auto tangential, auto rolling) {
+    using N = decltype(normal);
+    using T = decltype(tangential);
+    using R = decltype(rolling);
+    if (m.cohesion == CohesionLaw::sjkr) Stage<ContactLaw<N, T, R, SjkrCohesion>>::run(m, s);
+    else Stage<ContactLaw<N, T, R, NoCohesion>>::run(m, s);
+  };
+  auto with_rolling = [&](auto normal, auto tangential) {
+    switch (m.rolling) {
+      case RollingLaw::epsd: return with_cohesion(normal, tangential, EpsdRolling{});
+      case RollingLaw::cdt: return with_cohesion(normal, tangential, CdtRolling{});
+      case RollingLaw::none: return with_cohesion(normal, tangential, NoRolling{});
+    }
+  };
+  auto with_tangential = [&](auto normal) {
+    if (m.tangential == TangentialLaw::mindlin) with_rolling(normal, MindlinTangential{});
+    else with_rolling(normal, NoTangential{});
+  };
+  if (m.normal == NormalLaw::hertz) with_tangential(HertzNormal{});
+  else with_tangential(LinearNormal{});
+}
+
+template <class Law>
+struct PairStage {
+  static void run(const Model& m, State& s) { pair_forces<Law>(m, s); }
+};
+template <class Law>
+struct WallStage {
+  static void run(const Model& m, State& s) { wall_forces<Law>(m, s); }
+};
+
+}  // namespace
+
+void compute_pair_forces(const Model& model, State& state) { dispatch<PairStage>(model, state); }
+void compute_wall_forces(const Model& model, State& state) { dispatch<WallStage>(model, state); }
+
+void sum_forces(const Model& model, State& s) {
+  const NeighbourList& nl = s.neighbours;
+  const PairForces& pf = s.pair_forces;
+  const std::size_t n = s.size();
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!s.active[i]) {
+      s.f[i].setZero();
+      s.torque[i].setZero();
+      continue;
+    }
+    Vec3 f = s.mass[i] * model.gravity, t = Vec3::Zero();
+    for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p) {
+      f += pf.force[std::size_t(p)];
+      t += -pf.arm_i[std::size_t(p)] * pf.moment[std::size_t(p)] + pf.rolling[std::size_t(p)];
+    }
+    for (std::int32_t r = nl.reverse_start[i]; r < nl.reverse_start[i + 1]; ++r) {
+      const std::size_t p = std::size_t(nl.reverse_pair[std::size_t(r)]);
+      f -= pf.force[p];
+      t += -pf.arm_j[p] * pf.moment[p] - pf.rolling[p];
+    }
+    s.f[i] = f;
+    s.torque[i] = t;
+  }
+}
+
+double elastic_energy(const Model& model, const State& s) {
+  // Hertz: U = (8/15) E* sqrt(R*) δ^{5/2}; linear: U = k δ² / 2.
+  auto energy = [&](const PairParams& p, double r_eff, double overlap) {
+    if (model.normal == NormalLaw::linear) return 0.5 * p.k_linear * overlap * overlap;
+    return (8.0 / 15.0) * p.e_star * std::sqrt(r_eff) * overlap * overlap * std::sqrt(overlap);
+  };
+  double total = 0;
+  const NeighbourList& nl = s.neighbours;
+  for (std::size_t i = 0; i + 1 < nl.row_start.size(); ++i)
+    for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p) {
+      const std::size_t j = std::size_t(nl.partner[std::size_t(p)]);
+      const double reach = s.radius[i] + s.radius[j];
+      const double overlap = reach - (s.x[i] - s.x[j]).norm();
+      if (overlap > 0 && s.active[i] && s.active[j])
+        total += energy(model.params(s.material[i], s.material[j]), s.radius[i] * s.radius[j] / reach, overlap);
+    }
+  for (std::int32_t i : nl.near_wall) {
+    WallHit hits[wall_slots_per_particle];
+    const int count = wall_hits(model, s.time, s.x[std::size_t(i)], s.radius[std::size_t(i)], hits, wall_slots_per_particle);
+    for (int k = 0; k < count; ++k) {
+      const int wm = hits[k].wall < std::int32_t(model.planes.size())
+                         ? model.planes[std::size_t(hits[k].wall)].material
+                         : model.meshes[std::size_t(hits[k].wall) - model.planes.size()].material;
+      total += energy(model.params(s.material[std::size_t(i)], wm), s.radius[std::size_t(i)],
+                      s.radius[std::size_t(i)] - hits[k].distance);
+    }
+  }
+  return total;
+}
+
+}  // namespace dem

@@ -1,0 +1,168 @@
+#include "dem/model.hpp"
+
+#include <fmt/core.h>
+
+#include <cmath>
+#include <map>
+#include <numbers>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/sha256.hpp"
+#include "dem/state.hpp"
+
+namespace dem {
+
+using diefill::InputError;
+
+namespace {
+
+void check_material(const Material& m, std::size_t k, const std::string& source) {
+  const std::string field = fmt::format("materials[{}] ({})", k, m.name);
+  auto require = [&](bool ok, const char* key, const std::string& what) {
+    if (!ok) throw InputError(source, field + "." + key, what, "Correct the material");
+  };
+  require(m.density > 0 && std::isfinite(m.density), "density", "must be positive [kg/m³]");
+  require(m.youngs_modulus > 0 && std::isfinite(m.youngs_modulus), "youngs_modulus", "must be positive [Pa]");
+  require(m.poisson_ratio >= 0 && m.poisson_ratio < 0.5, "poisson_ratio", "must lie in [0, 0.5)");
+  require(m.restitution > 0 && m.restitution <= 1, "restitution", "must lie in (0, 1]");
+  require(m.sliding_friction >= 0, "sliding_friction", "must not be negative");
+  require(m.rolling_friction >= 0, "rolling_friction", "must not be negative");
+  require(m.cohesion_energy_density >= 0, "cohesion_energy_density", "must not be negative [J/m³]");
+}
+
+double shear_modulus(const Material& m) { return m.youngs_modulus / (2 * (1 + m.poisson_ratio)); }
+
+// Rayleigh wave time of a grain (PHYSICS.md §5).
+double rayleigh_time(const Material& m, double radius) {
+  return std::numbers::pi * radius * std::sqrt(m.density / shear_modulus(m)) /
+         (0.1631 * m.poisson_ratio + 0.8766);
+}
+
+// Hertz collision time at impact speed v: 2.9432 δmax / v, δmax = (15 m* v² / (16 E* √R*))^(2/5).
+double hertz_time(double e_star, double r_eff, double m_eff, double v) {
+  const double overlap = std::pow(15 * m_eff * v * v / (16 * e_star * std::sqrt(r_eff)), 0.4);
+  return 2.9432 * overlap / v;
+}
+
+}  // namespace
+
+Model compile_model(const ModelSpec& spec, const State& state, const std::string& source) {
+  if (spec.materials.empty())
+    throw InputError(source, "materials", "no material is defined", "Add a [[materials]] table");
+  for (std::size_t k = 0; k < spec.materials.size(); ++k) check_material(spec.materials[k], k, source);
+  const int nm = int(spec.materials.size());
+  for (std::size_t i = 0; i < state.size(); ++i)
+    if (state.material[i] < 0 || state.material[i] >= nm)
+      throw InputError(source, "particles.material", fmt::format("grain {} names material {} of {}", state.id[i], state.material[i], nm),
+                       "Give every grain a defined material");
+  if (spec.normal == NormalLaw::linear && !(spec.linear_stiffness > 0))
+    throw InputError(source, "contact.linear_stiffness", "the linear normal law needs a positive stiffness [N/m]",
+                     "Set contact.linear_stiffness");
+
+  Model m;
+  m.materials = spec.materials;
+  m.normal = spec.normal;
+  m.tangential = spec.tangential;
+  m.rolling = spec.rolling;
+  m.cohesion = spec.cohesion;
+  m.gravity = spec.gravity;
+  m.domain = spec.domain;
+  m.planes = spec.planes;
+  m.meshes = spec.meshes;
+  m.stop_overlap = spec.stop_overlap;
+  for (PlaneWall& p : m.planes) p.normal.normalize();
+
+  // Pairs: Hertz effective moduli; unlike materials mix e, μ and cohesion by the geometric
+  // mean unless an interaction says otherwise.
+  m.pair_table.resize(std::size_t(nm * nm));
+  std::map<double, double> damping_of;  // calibration is shared by pairs with the same e
+  for (int a = 0; a < nm; ++a)
+    for (int b = 0; b < nm; ++b) {
+      const Material &ma = m.materials[std::size_t(a)], &mb = m.materials[std::size_t(b)];
+      PairParams p;
+      p.e_star = 1.0 / ((1 - ma.poisson_ratio * ma.poisson_ratio) / ma.youngs_modulus +
+                        (1 - mb.poisson_ratio * mb.poisson_ratio) / mb.youngs_modulus);
+      p.g_star = 1.0 / ((2 - ma.poisson_ratio) / shear_modulus(ma) + (2 - mb.poisson_ratio) / shear_modulus(mb));
+      p.restitution = std::sqrt(ma.restitution * mb.restitution);
+      p.mu_s = std::sqrt(ma.sliding_friction * mb.sliding_friction);
+      p.mu_r = std::sqrt(ma.rolling_friction * mb.rolling_friction);
+      p.cohesion = std::sqrt(ma.cohesion_energy_density * mb.cohesion_energy_density);
+      p.k_linear = spec.linear_stiffness;
+      for (const Interaction& it : spec.interactions)
+        if ((it.a == a && it.b == b) || (it.a == b && it.b == a)) {
+          if (it.restitution) p.restitution = *it.restitution;
+          if (it.sliding_friction) p.mu_s = *it.sliding_friction;
+          if (it.rolling_friction) p.mu_r = *it.rolling_friction;
+        }
+      if (!(p.restitution > 0 && p.restitution <= 1))
+        throw InputError(source, "interactions.restitution", "must lie in (0, 1]", "Correct the interaction");
+      auto it = damping_of.find(p.restitution);
+      if (it == damping_of.end()) it = damping_of.emplace(p.restitution, damping_for_restitution(m.normal, p.restitution)).first;
+      p.damping = it->second;
+      m.pair_table[std::size_t(a * nm + b)] = p;
+    }
+
+  // Time step: a fraction of the smaller of the Rayleigh time and the collision time at the
+  // highest expected impact speed, over the grains present.
+  m.max_radius = 0;
+  double min_radius = std::numeric_limits<double>::infinity();
+  m.dt_rayleigh = std::numeric_limits<double>::infinity();
+  m.dt_hertz = std::numeric_limits<double>::infinity();
+  std::map<std::pair<int, double>, bool> seen;
+  for (std::size_t i = 0; i < state.size(); ++i) {
+    m.max_radius = std::max(m.max_radius, state.radius[i]);
+    min_radius = std::min(min_radius, state.radius[i]);
+    if (!seen.emplace(std::pair{state.material[i], state.radius[i]}, true).second) continue;
+    const Material& mat = m.materials[std::size_t(state.material[i])];
+    m.dt_rayleigh = std::min(m.dt_rayleigh, rayleigh_time(mat, state.radius[i]));
+    for (int b = 0; b < nm; ++b) {
+      const PairParams& p = m.params(state.material[i], b);
+      const double v = std::max(spec.max_impact_speed, 1e-3);
+      // Against an equal grain, and against a wall (R* = r, m* = m).
+      const double r = state.radius[i], mass = state.mass[i];
+      if (m.normal == NormalLaw::hertz) {
+        m.dt_hertz = std::min({m.dt_hertz, hertz_time(p.e_star, r / 2, mass / 2, v), hertz_time(p.e_star, r, mass, v)});
+      } else {
+        m.dt_hertz = std::min(m.dt_hertz, std::numbers::pi * std::sqrt(0.5 * mass / p.k_linear));
+      }
+    }
+  }
+  const double stable = std::min(m.dt_rayleigh, m.dt_hertz);
+  if (spec.time_step) {
+    if (!(*spec.time_step > 0))
+      throw InputError(source, "simulation.time_step", "must be positive or \"auto\"", "Give seconds or \"auto\"");
+    m.dt = *spec.time_step;
+    if (std::isfinite(stable) && m.dt > 0.3 * stable)
+      diefill::log::warn("{}: simulation.time_step {:.3g} s is {:.2g} of the stable limit {:.3g} s (Rayleigh {:.3g} s, "
+                         "collision {:.3g} s); expect overlaps and energy growth beyond about 0.3",
+                         source, m.dt, m.dt / stable, stable, m.dt_rayleigh, m.dt_hertz);
+  } else {
+    m.dt = std::isfinite(stable) ? spec.time_step_fraction * stable : 1e-5;
+  }
+  m.skin = spec.skin ? *spec.skin : 0.5 * m.max_radius;
+  if (!(m.skin > 0))
+    throw InputError(source, "simulation.skin", "must be positive [m]", "Give a skin of about half a grain radius");
+  // The list is checked every step, so a grain may move at most half the skin per step.
+  if (spec.max_impact_speed * m.dt > 0.5 * m.skin)
+    diefill::log::warn("{}: at {:.3g} m/s a grain moves {:.3g} m per step, more than half the neighbour skin "
+                       "{:.3g} m: contacts could be missed. Lower the time step or widen the skin",
+                       source, spec.max_impact_speed, spec.max_impact_speed * m.dt, m.skin);
+  m.cell_size = 2 * m.max_radius + m.skin;
+
+  std::string text = fmt::format("dt={:a};skin={:a};g={:a},{:a},{:a};laws={},{},{},{};stop={:a};dom={:a},{:a},{:a},{:a},{:a},{:a}",
+                                 m.dt, m.skin, m.gravity.x(), m.gravity.y(), m.gravity.z(), int(m.normal),
+                                 int(m.tangential), int(m.rolling), int(m.cohesion), m.stop_overlap,
+                                 m.domain.lo.x(), m.domain.lo.y(), m.domain.lo.z(), m.domain.hi.x(),
+                                 m.domain.hi.y(), m.domain.hi.z());
+  for (const PairParams& p : m.pair_table)
+    text += fmt::format(";{:a},{:a},{:a},{:a},{:a},{:a},{:a}", p.e_star, p.g_star, p.damping, p.mu_s, p.mu_r, p.k_linear, p.cohesion);
+  for (const PlaneWall& p : m.planes)
+    text += fmt::format(";plane{:a},{:a},{:a},{:a},{:a},{:a},{}", p.point.x(), p.point.y(), p.point.z(), p.normal.x(), p.normal.y(), p.normal.z(), p.material);
+  for (const MeshWall& w : m.meshes)
+    text += fmt::format(";mesh{},{},{},{}", w.name, w.field->triangles.size(), w.field->voxel, w.material);
+  m.hash = diefill::sha256_hex(text);
+  return m;
+}
+
+}  // namespace dem

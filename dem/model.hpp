@@ -1,0 +1,104 @@
+#pragma once
+// The simulation's Model (immutable while stepping) and the spec it is compiled from, after
+// MuJoCo's mjModel/mjData split: every stage is `void stage(const Model&, State&)`.
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dem/contact.hpp"
+#include "dem/motion.hpp"
+#include "dem/types.hpp"
+#include "mesh/wall_field.hpp"
+
+namespace dem {
+
+struct Material {
+  std::string name;
+  double density = 2500;            // [kg/m³]
+  double youngs_modulus = 5e6;      // [Pa]
+  double poisson_ratio = 0.3;
+  double restitution = 0.5;
+  double sliding_friction = 0.5;
+  double rolling_friction = 0.0;    // dimensionless
+  double cohesion_energy_density = 0.0;  // [J/m³] (SJKR)
+};
+
+// Overrides the mixing rule for one pair of materials.
+struct Interaction {
+  int a = 0, b = 0;
+  std::optional<double> restitution, sliding_friction, rolling_friction;
+};
+
+struct PlaneWall {
+  Vec3 point = Vec3::Zero();
+  Vec3 normal = Vec3::UnitZ();  // unit, towards the particles
+  int material = 0;
+  std::string name = "plane";
+};
+
+// A rigid wall given by a distance field in its own frame, placed by its motion.
+struct MeshWall {
+  std::shared_ptr<const mesh::WallField> field;
+  int material = 0;
+  Motion motion;
+  std::string name = "mesh";
+};
+
+struct Box3 {
+  Vec3 lo = Vec3::Constant(-1), hi = Vec3::Constant(1);
+  bool contains(const Vec3& p) const { return (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all(); }
+};
+
+// What the scene says, before any derived quantity exists.
+struct ModelSpec {
+  std::vector<Material> materials;
+  std::vector<Interaction> interactions;
+  NormalLaw normal = NormalLaw::hertz;
+  TangentialLaw tangential = TangentialLaw::mindlin;
+  RollingLaw rolling = RollingLaw::none;
+  CohesionLaw cohesion = CohesionLaw::none;
+  Vec3 gravity = Vec3(0, 0, -9.81);
+  std::optional<double> time_step;    // [s]; automatic when absent
+  double time_step_fraction = 0.15;   // of the smaller of the Rayleigh and Hertz times
+  double max_impact_speed = 1.0;      // [m/s] for the Hertz collision time
+  std::optional<double> skin;         // [m]; default 0.5 of the largest radius
+  Box3 domain;                        // particles leaving it are counted as lost
+  std::vector<PlaneWall> planes;
+  std::vector<MeshWall> meshes;
+  double linear_stiffness = 0.0;      // [N/m] for the linear normal law
+  double stop_overlap = 0.1;          // largest δ/R before the run stops (stability)
+};
+
+struct Model {
+  std::vector<Material> materials;
+  std::vector<PairParams> pair_table;  // [materials²], symmetric
+  NormalLaw normal;
+  TangentialLaw tangential;
+  RollingLaw rolling;
+  CohesionLaw cohesion;
+  Vec3 gravity;
+  double dt;                    // [s]
+  double dt_rayleigh;           // [s] smallest Rayleigh time of the particles
+  double dt_hertz;              // [s] Hertz collision time at max_impact_speed
+  double skin;                  // [m]
+  double cell_size;             // [m] neighbour grid
+  double max_radius;            // [m]
+  Box3 domain;
+  std::vector<PlaneWall> planes;
+  std::vector<MeshWall> meshes;
+  double stop_overlap;
+  std::string hash;             // of every parameter above: checkpoints carry it
+
+  const PairParams& params(int a, int b) const {
+    return pair_table[std::size_t(a) * materials.size() + std::size_t(b)];
+  }
+  int wall_count() const { return int(planes.size() + meshes.size()); }
+};
+
+struct State;
+// Checks the spec (throws diefill::InputError naming `source` and the field), mixes material
+// pairs, calibrates damping, chooses the time step and skin for the particles in `state`.
+Model compile_model(const ModelSpec& spec, const State& state, const std::string& source);
+
+}  // namespace dem

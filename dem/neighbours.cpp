@@ -1,0 +1,211 @@
+#include "dem/neighbours.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <numeric>
+
+#include "dem/walls.hpp"
+
+namespace dem {
+
+namespace {
+
+struct CellGrid {
+  Vec3 origin;
+  double size;
+  std::array<int, 3> dims;
+  std::vector<std::int32_t> start;   // [cells+1]
+  std::vector<std::int32_t> members; // particle indices sorted by cell, ascending within a cell
+
+  int cell_coord(double x, int axis) const {
+    return std::clamp(int((x - origin[axis]) / size), 0, dims[std::size_t(axis)] - 1);
+  }
+  std::size_t cell_of(const Vec3& p) const {
+    return (std::size_t(cell_coord(p.x(), 0)) * std::size_t(dims[1]) + std::size_t(cell_coord(p.y(), 1))) *
+               std::size_t(dims[2]) + std::size_t(cell_coord(p.z(), 2));
+  }
+};
+
+// The grid spans the active grains (not the whole domain, which may be far larger), with cells
+// no smaller than the interaction reach and no more cells than a few per grain.
+CellGrid make_grid(const Model& model, const State& s) {
+  CellGrid g;
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  std::size_t active = 0;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (s.active[i]) lo = lo.cwiseMin(s.x[i]), hi = hi.cwiseMax(s.x[i]), ++active;
+  if (active == 0) lo = hi = Vec3::Zero();
+  g.origin = lo;
+  g.size = model.cell_size;
+  const Vec3 extent = hi - lo;
+  while ((extent / g.size).array().floor().cwiseMax(1.0).prod() > 8.0 * double(std::max<std::size_t>(active, 1)) + 1000)
+    g.size *= 1.25;
+  for (int a = 0; a < 3; ++a) g.dims[std::size_t(a)] = std::max(1, int(extent[a] / g.size));
+  const std::size_t cells = std::size_t(g.dims[0]) * std::size_t(g.dims[1]) * std::size_t(g.dims[2]);
+  g.start.assign(cells + 1, 0);
+  std::vector<std::size_t> cell(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (!s.active[i]) continue;
+    cell[i] = g.cell_of(s.x[i]);
+    ++g.start[cell[i] + 1];
+  }
+  for (std::size_t c = 0; c < cells; ++c) g.start[c + 1] += g.start[c];
+  g.members.resize(std::size_t(g.start[cells]));
+  std::vector<std::int32_t> fill(g.start.begin(), g.start.end() - 1);
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (s.active[i]) g.members[std::size_t(fill[cell[i]]++)] = std::int32_t(i);
+  return g;
+}
+
+// Applies `order` (new index -> old index) to every per-particle array.
+template <typename T>
+void permute(std::vector<T>& a, const std::vector<std::int32_t>& order) {
+  std::vector<T> out(order.size());
+  for (std::size_t n = 0; n < order.size(); ++n) out[n] = a[std::size_t(order[n])];
+  a.swap(out);
+}
+
+void sort_particles(State& s, const CellGrid& g, std::vector<std::int32_t>& new_index) {
+  // Active particles in cell order, lost ones after them (in their old order).
+  std::vector<std::int32_t> order(g.members);
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (!s.active[i]) order.push_back(std::int32_t(i));
+  new_index.assign(s.size(), -1);
+  for (std::size_t n = 0; n < order.size(); ++n) new_index[std::size_t(order[n])] = std::int32_t(n);
+  permute(s.id, order);
+  permute(s.x, order);
+  permute(s.v, order);
+  permute(s.w, order);
+  permute(s.f, order);
+  permute(s.torque, order);
+  permute(s.radius, order);
+  permute(s.mass, order);
+  permute(s.inertia, order);
+  permute(s.material, order);
+  permute(s.active, order);
+  std::vector<WallSlot> slots(s.wall_slots.size());
+  for (std::size_t n = 0; n < order.size(); ++n)
+    for (int k = 0; k < wall_slots_per_particle; ++k)
+      slots[n * wall_slots_per_particle + std::size_t(k)] =
+          s.wall_slots[std::size_t(order[n]) * wall_slots_per_particle + std::size_t(k)];
+  s.wall_slots.swap(slots);
+}
+
+struct OldPair {
+  std::int32_t i, j;
+  ContactHistory history;
+};
+
+}  // namespace
+
+bool needs_rebuild(const Model& model, const State& s) {
+  const NeighbourList& nl = s.neighbours;
+  if (nl.x_at_build.size() != s.size()) return true;
+  double worst = 0;
+  const std::size_t n = s.size();
+#pragma omp parallel for reduction(max : worst) schedule(static)
+  for (std::size_t i = 0; i < n; ++i)
+    if (s.active[i]) worst = std::max(worst, (s.x[i] - nl.x_at_build[i]).squaredNorm());
+  double wall_shift = 0;
+  for (std::size_t m = 0; m < model.meshes.size(); ++m)
+    wall_shift = std::max(wall_shift, (model.meshes[m].motion.position(s.time) - nl.wall_shift_at_build[m]).norm());
+  // A rotating wall moves its points by up to |ω| r; the shoe does not rotate, others are fixed.
+  return std::sqrt(worst) + wall_shift > 0.5 * model.skin;
+}
+
+void rebuild_neighbours(const Model& model, State& s) {
+  // Particles outside the domain are lost: counted, frozen, never silently dropped.
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (s.active[i] && !model.domain.contains(s.x[i])) {
+      s.active[i] = 0;
+      s.v[i].setZero();
+      s.w[i].setZero();
+      ++s.lost;
+    }
+
+  // Old pairs with their history, by particle index before sorting.
+  NeighbourList& nl = s.neighbours;
+  std::vector<OldPair> old;
+  old.reserve(nl.partner.size());
+  for (std::size_t i = 0; i + 1 < nl.row_start.size(); ++i)
+    for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p)
+      if (nl.history[std::size_t(p)].tangential.squaredNorm() > 0 || nl.history[std::size_t(p)].rolling.squaredNorm() > 0)
+        old.push_back({std::int32_t(i), nl.partner[std::size_t(p)], nl.history[std::size_t(p)]});
+
+  CellGrid grid = make_grid(model, s);
+  std::vector<std::int32_t> new_index;
+  sort_particles(s, grid, new_index);
+  grid = make_grid(model, s);  // members now ascending along the cells
+  // Re-key old pairs to the new indices, smaller index first (history is i's view: negate).
+  for (OldPair& o : old) {
+    o.i = new_index[std::size_t(o.i)];
+    o.j = new_index[std::size_t(o.j)];
+    if (o.i > o.j) {
+      std::swap(o.i, o.j);
+      o.history.tangential = -o.history.tangential;
+      o.history.rolling = -o.history.rolling;
+    }
+  }
+  std::sort(old.begin(), old.end(), [](const OldPair& a, const OldPair& b) {
+    return a.i != b.i ? a.i < b.i : a.j < b.j;
+  });
+
+  // Rows in parallel: every particle scans the 27 cells around it for j > i within reach.
+  const std::size_t n = s.size();
+  std::vector<std::vector<std::int32_t>> rows(n);
+#pragma omp parallel for schedule(dynamic, 256)
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!s.active[i]) continue;
+    const Vec3& xi = s.x[i];
+    const int cx = grid.cell_coord(xi.x(), 0), cy = grid.cell_coord(xi.y(), 1), cz = grid.cell_coord(xi.z(), 2);
+    std::vector<std::int32_t>& row = rows[i];
+    for (int a = std::max(0, cx - 1); a <= std::min(grid.dims[0] - 1, cx + 1); ++a)
+      for (int b = std::max(0, cy - 1); b <= std::min(grid.dims[1] - 1, cy + 1); ++b)
+        for (int c = std::max(0, cz - 1); c <= std::min(grid.dims[2] - 1, cz + 1); ++c) {
+          const std::size_t cell = (std::size_t(a) * std::size_t(grid.dims[1]) + std::size_t(b)) * std::size_t(grid.dims[2]) + std::size_t(c);
+          for (std::int32_t m = grid.start[cell]; m < grid.start[cell + 1]; ++m) {
+            const std::int32_t j = grid.members[std::size_t(m)];
+            if (j <= std::int32_t(i)) continue;
+            const double reach = s.radius[i] + s.radius[std::size_t(j)] + model.skin;
+            if ((s.x[std::size_t(j)] - xi).squaredNorm() < reach * reach) row.push_back(j);
+          }
+        }
+    std::sort(row.begin(), row.end());
+  }
+
+  nl.row_start.assign(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) nl.row_start[i + 1] = nl.row_start[i] + std::int32_t(rows[i].size());
+  const std::size_t pairs = std::size_t(nl.row_start[n]);
+  nl.partner.resize(pairs);
+  nl.history.assign(pairs, ContactHistory{});
+  std::size_t cursor = 0;  // into `old`, which is sorted like the new list
+  for (std::size_t i = 0; i < n; ++i) {
+    std::size_t p = std::size_t(nl.row_start[i]);
+    for (std::int32_t j : rows[i]) {
+      nl.partner[p] = j;
+      while (cursor < old.size() && (old[cursor].i < std::int32_t(i) || (old[cursor].i == std::int32_t(i) && old[cursor].j < j))) ++cursor;
+      if (cursor < old.size() && old[cursor].i == std::int32_t(i) && old[cursor].j == j) nl.history[p] = old[cursor].history;
+      ++p;
+    }
+  }
+  // Reverse index: for each j, the pairs naming it, ascending.
+  nl.reverse_start.assign(n + 1, 0);
+  for (std::int32_t j : nl.partner) ++nl.reverse_start[std::size_t(j) + 1];
+  for (std::size_t i = 0; i < n; ++i) nl.reverse_start[i + 1] += nl.reverse_start[i];
+  nl.reverse_pair.resize(pairs);
+  std::vector<std::int32_t> fill(nl.reverse_start.begin(), nl.reverse_start.end() - 1);
+  for (std::size_t p = 0; p < pairs; ++p) nl.reverse_pair[std::size_t(fill[std::size_t(nl.partner[p])]++)] = std::int32_t(p);
+
+  nl.x_at_build = s.x;
+  nl.wall_shift_at_build.resize(model.meshes.size());
+  for (std::size_t m = 0; m < model.meshes.size(); ++m) nl.wall_shift_at_build[m] = model.meshes[m].motion.position(s.time);
+  collect_near_wall(model, s);
+  s.pair_forces.force.resize(pairs);
+  s.pair_forces.moment.resize(pairs);
+  s.pair_forces.rolling.resize(pairs);
+  s.pair_forces.arm_i.resize(pairs);
+  s.pair_forces.arm_j.resize(pairs);
+  ++nl.builds;
+}
+
+}  // namespace dem

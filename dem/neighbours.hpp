@@ -1,0 +1,15 @@
+#pragma once
+// Neighbour search: a cell grid over the domain builds a Verlet half list with a skin, rebuilt
+// exactly when the largest displacement since the last build (particles relative to each
+// other, or to a moving wall) exceeds half the skin. Contact history survives rebuilds.
+// Particles are re-sorted along the cells at every rebuild, for memory locality. O(N).
+#include "dem/model.hpp"
+#include "dem/state.hpp"
+
+namespace dem {
+
+bool needs_rebuild(const Model& model, const State& state);
+// Marks particles outside the domain as lost, re-sorts, rebuilds the list, carries history.
+void rebuild_neighbours(const Model& model, State& state);
+
+}  // namespace dem

@@ -1,1 +1,0 @@
-// The DEM core arrives with issue 3.

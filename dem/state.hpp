@@ -1,0 +1,84 @@
+#pragma once
+// Everything that changes while stepping. Particles are a structure of arrays; the neighbour
+// list is a half list (j > i) in compressed rows, with each pair's contact history beside it
+// and per-pair force buffers, so that per-particle sums run in a fixed order whatever the
+// thread count (bit-identical results). Shapes: N particles, P listed pairs, K wall slots.
+#include <cstdint>
+#include <vector>
+
+#include "dem/contact.hpp"
+#include "dem/types.hpp"
+
+namespace dem {
+
+inline constexpr int wall_slots_per_particle = 4;  // K: contacts one grain keeps with walls
+
+struct WallSlot {
+  std::int32_t wall = -1;  // planes first, then mesh walls; -1: empty
+  Vec3 normal = Vec3::Zero();  // last contact normal, to recognise the contact next step
+  ContactHistory history;
+};
+
+struct NeighbourList {
+  std::vector<std::int32_t> row_start;      // [N+1] pairs of particle i: [row_start[i], row_start[i+1])
+  std::vector<std::int32_t> partner;        // [P] j > i
+  std::vector<ContactHistory> history;      // [P]
+  std::vector<std::int32_t> reverse_start;  // [N+1] pairs where particle j is the partner
+  std::vector<std::int32_t> reverse_pair;   // [P] pair indices, ascending
+  std::vector<std::int32_t> near_wall;      // particles within range of a wall at build time
+  std::vector<Vec3> x_at_build;             // [N] [m]
+  std::vector<Vec3> wall_shift_at_build;    // [mesh walls] [m] wall origin at build time
+  std::int64_t builds = 0;
+};
+
+// Per-pair results of the force stage, summed per particle afterwards in a fixed order.
+struct PairForces {
+  std::vector<Vec3> force;     // [P] on i [N]
+  std::vector<Vec3> moment;    // [P] n x F_t [N]: torque on i is -a_i n x F, on j -a_j n x F
+  std::vector<Vec3> rolling;   // [P] rolling torque on i [N m]; j gets the opposite
+  std::vector<double> arm_i, arm_j;  // [P] lever arms [m]
+};
+
+struct StepCounters {
+  double max_overlap_rel = 0;   // largest δ/R this step
+  std::int64_t contacts = 0;    // pair contacts this step
+  std::int64_t wall_contacts = 0;
+  double wall_power = 0;        // power walls deliver to particles [W]
+};
+
+struct State {
+  // Particles [N]
+  std::vector<std::int64_t> id;
+  std::vector<Vec3> x;          // position [m]
+  std::vector<Vec3> v;          // velocity [m/s]
+  std::vector<Vec3> w;          // angular velocity [rad/s]
+  std::vector<Vec3> f;          // force [N]
+  std::vector<Vec3> torque;     // [N m]
+  std::vector<double> radius;   // [m]
+  std::vector<double> mass;     // [kg]
+  std::vector<double> inertia;  // [kg m²] (solid sphere: 2/5 m r²)
+  std::vector<std::int32_t> material;
+  std::vector<std::uint8_t> active;  // 0: lost (left the domain), no longer simulated
+  std::vector<WallSlot> wall_slots;  // [N*K]
+
+  NeighbourList neighbours;
+  PairForces pair_forces;
+  StepCounters counters;
+  std::vector<double> scratch_wall_power;  // [near-wall grains], summed serially
+
+  double time = 0;              // [s]
+  std::int64_t step = 0;
+  std::int64_t lost = 0;        // particles that left the domain
+  double wall_work = 0;         // energy walls delivered to particles so far [J]
+  double energy_reference = 0;  // mechanical energy at initialize() [J]
+  double energy_scale = 0;      // Σ m g r: the energy of a grain-radius drop of every grain [J]
+  bool energy_reference_set = false;
+
+  std::size_t size() const { return x.size(); }
+  // Appends a sphere; density in kg/m³.
+  void add_sphere(std::int64_t particle_id, const Vec3& position, double r, double density,
+                  int material_index, const Vec3& velocity = Vec3::Zero(),
+                  const Vec3& angular_velocity = Vec3::Zero());
+};
+
+}  // namespace dem

@@ -1,0 +1,149 @@
+#include "dem/step.hpp"
+
+#include <fmt/core.h>
+
+#include <cmath>
+
+#include "core/sha256.hpp"
+#include "core/timer.hpp"
+#include "dem/forces.hpp"
+#include "dem/neighbours.hpp"
+
+namespace dem {
+
+namespace {
+
+void kick(State& s, double half_dt) {
+  const std::size_t n = s.size();
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!s.active[i]) continue;
+    s.v[i] += (half_dt / s.mass[i]) * s.f[i];
+    s.w[i] += (half_dt / s.inertia[i]) * s.torque[i];
+  }
+}
+
+void drift(State& s, double dt) {
+  const std::size_t n = s.size();
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i)
+    if (s.active[i]) s.x[i] += dt * s.v[i];
+}
+
+void forces(const Model& model, State& s, StageTimes* times) {
+  diefill::Stopwatch clock;
+  compute_pair_forces(model, s);
+  if (times) times->pair_forces += clock.seconds(), clock.restart();
+  sum_forces(model, s);
+  if (times) times->sums += clock.seconds(), clock.restart();
+  compute_wall_forces(model, s);
+  if (times) times->wall_forces += clock.seconds();
+}
+
+// Mechanical energy may only grow by what walls deliver; checked every `energy_interval` steps.
+constexpr int energy_interval = 200;
+
+StepReport monitor(const Model& model, State& s) {
+  StepReport r;
+  s.wall_work += s.counters.wall_power * model.dt;
+  if (s.counters.max_overlap_rel > model.stop_overlap) {
+    r.status = StepStatus::overlap;
+    r.message = fmt::format(
+        "a contact overlap reached {:.3g} of the grain radius (limit {:.3g}) at t = {:.6g} s: the "
+        "time step {:.3g} s is too large for the stiffness or the impact speed. Lower "
+        "simulation.time_step (or its fraction), soften the material, or slow the walls",
+        s.counters.max_overlap_rel, model.stop_overlap, s.time, model.dt);
+    return r;
+  }
+  if (s.step % energy_interval != 0) return r;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (s.active[i] && !(s.x[i].allFinite() && s.v[i].allFinite() && s.w[i].allFinite())) {
+      r.status = StepStatus::non_finite;
+      r.message = fmt::format("grain {} has a non-finite position or velocity at t = {:.6g} s: the "
+                              "integration diverged. Lower simulation.time_step",
+                              s.id[i], s.time);
+      return r;
+    }
+  const double energy = kinetic_energy(s) + potential_energy(model, s) + elastic_energy(model, s);
+  if (s.energy_reference_set) {
+    const double budget = s.energy_reference + s.wall_work;
+    const double slack = 1e-3 * std::abs(s.energy_reference) + 1e-3 * s.energy_scale + 1e-12;
+    if (energy > budget + slack) {
+      r.status = StepStatus::energy_growth;
+      r.message = fmt::format(
+          "the grains' energy grew to {:.4g} J, beyond the {:.4g} J gravity and the walls can "
+          "have given them, at t = {:.6g} s: the time step {:.3g} s is unstable. Lower "
+          "simulation.time_step",
+          energy, budget, s.time, model.dt);
+    }
+  }
+  return r;
+}
+
+}  // namespace
+
+double kinetic_energy(const State& s) {
+  double e = 0;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (s.active[i]) e += 0.5 * s.mass[i] * s.v[i].squaredNorm() + 0.5 * s.inertia[i] * s.w[i].squaredNorm();
+  return e;
+}
+
+double potential_energy(const Model& model, const State& s) {
+  double e = 0;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (s.active[i]) e -= s.mass[i] * model.gravity.dot(s.x[i]);
+  return e;
+}
+
+void initialize(const Model& model, State& s) {
+  s.f.resize(s.size(), Vec3::Zero());
+  s.torque.resize(s.size(), Vec3::Zero());
+  s.wall_slots.resize(s.size() * wall_slots_per_particle);
+  rebuild_neighbours(model, s);
+  forces(model, s, nullptr);
+  s.energy_reference = kinetic_energy(s) + potential_energy(model, s) + elastic_energy(model, s);
+  s.energy_scale = 0;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    s.energy_scale += s.mass[i] * model.gravity.norm() * s.radius[i];
+  s.energy_reference_set = true;
+}
+
+StepReport step(const Model& model, State& s, StageTimes* times) {
+  diefill::Stopwatch clock;
+  kick(s, 0.5 * model.dt);
+  drift(s, model.dt);
+  s.time += model.dt;
+  ++s.step;
+  if (times) times->integration += clock.seconds(), clock.restart();
+  if (needs_rebuild(model, s)) rebuild_neighbours(model, s);
+  if (times) times->neighbours += clock.seconds(), clock.restart();
+  forces(model, s, times);
+  clock.restart();
+  kick(s, 0.5 * model.dt);
+  if (times) times->integration += clock.seconds(), clock.restart();
+  StepReport report = monitor(model, s);
+  if (times) times->monitor += clock.seconds();
+  return report;
+}
+
+std::string state_hash(const State& s) {
+  diefill::Sha256 h;
+  auto put = [&h](const auto& v) { h.update(v.data(), v.size() * sizeof(v[0])); };
+  put(s.id);
+  put(s.x);
+  put(s.v);
+  put(s.w);
+  put(s.active);
+  put(s.neighbours.history);
+  for (const WallSlot& w : s.wall_slots) {
+    h.update(&w.wall, sizeof w.wall);
+    h.update(w.history.tangential.data(), sizeof(double) * 3);
+    h.update(w.history.rolling.data(), sizeof(double) * 3);
+  }
+  h.update(&s.time, sizeof s.time);
+  h.update(&s.step, sizeof s.step);
+  return h.hex();
+}
+
+}  // namespace dem

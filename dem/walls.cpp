@@ -1,0 +1,58 @@
+#include "dem/walls.hpp"
+
+#include <limits>
+
+namespace dem {
+
+int wall_hits(const Model& model, double time, const Vec3& x, double r, WallHit* out, int capacity) {
+  int count = 0;
+  for (std::size_t p = 0; p < model.planes.size() && count < capacity; ++p) {
+    const PlaneWall& plane = model.planes[p];
+    const double d = (x - plane.point).dot(plane.normal);
+    if (d >= r) continue;
+    out[count++] = {std::int32_t(p), plane.normal, d, x - d * plane.normal, Vec3::Zero(), Vec3::Zero()};
+  }
+  for (std::size_t m = 0; m < model.meshes.size() && count < capacity; ++m) {
+    const MeshWall& wall = model.meshes[m];
+    const Vec3 local = wall.motion.to_local(time, x);
+    mesh::SurfacePoint minima[wall_slots_per_particle];
+    const int n = wall.field->local_minima(local, r, minima, wall_slots_per_particle);
+    const Quat q = wall.motion.orientation(time);
+    for (int k = 0; k < n && count < capacity; ++k) {
+      const Vec3 normal = q * minima[k].normal;
+      const Vec3 point = x - minima[k].distance * normal;
+      out[count++] = {std::int32_t(model.planes.size() + m), normal, minima[k].distance, point,
+                      wall.motion.point_velocity(time, point), wall.motion.angular_velocity};
+    }
+  }
+  return count;
+}
+
+double wall_distance(const Model& model, double time, const Vec3& x) {
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const PlaneWall& plane : model.planes) nearest = std::min(nearest, (x - plane.point).dot(plane.normal));
+  for (const MeshWall& wall : model.meshes) {
+    const double d = wall.field->trilinear(wall.motion.to_local(time, x));
+    if (std::abs(d) < std::abs(nearest)) nearest = d;
+  }
+  return nearest;
+}
+
+void collect_near_wall(const Model& model, State& s) {
+  std::vector<std::int32_t>& near = s.neighbours.near_wall;
+  near.clear();
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (!s.active[i]) continue;
+    const double reach = s.radius[i] + model.skin;
+    bool close = false;
+    for (const PlaneWall& plane : model.planes) close |= (s.x[i] - plane.point).dot(plane.normal) < reach;
+    for (const MeshWall& wall : model.meshes) {
+      // Trilinear values are within a voxel of the truth; beyond the band they are ± background.
+      if (close) break;
+      close = wall.field->trilinear(wall.motion.to_local(s.time, s.x[i])) < reach + wall.field->voxel;
+    }
+    if (close) near.push_back(std::int32_t(i));
+  }
+}
+
+}  // namespace dem

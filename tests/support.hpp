@@ -1,0 +1,71 @@
+#pragma once
+// Helpers shared by the tests: temporary folders, running the diefill executable, test meshes.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <sys/wait.h>
+
+namespace test {
+
+namespace fs = std::filesystem;
+
+// A fresh folder under the system temporary directory, removed with the object.
+class TempDir {
+ public:
+  TempDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = std::string("diefill-") + (info ? info->test_suite_name() : "x") + "-" +
+                       (info ? info->name() : "y") + "-" + std::to_string(::getpid());
+    for (char& c : name)
+      if (c == '/') c = '_';
+    path_ = fs::temp_directory_path() / name;
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TempDir() { fs::remove_all(path_); }
+  const fs::path& path() const { return path_; }
+  fs::path operator/(const std::string& leaf) const { return path_ / leaf; }
+
+ private:
+  fs::path path_;
+};
+
+struct Run {
+  int status = -1;     // exit status
+  std::string output;  // stdout and stderr together
+};
+
+// Runs the diefill executable with `arguments` (a shell-quoted string).
+inline Run run_diefill(const std::string& arguments) {
+  Run run;
+  const std::string command = std::string(DIEFILL_EXECUTABLE) + " " + arguments + " 2>&1";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (!pipe) return run;
+  char buffer[4096];
+  while (std::size_t n = std::fread(buffer, 1, sizeof buffer, pipe)) run.output.append(buffer, n);
+  const int raw = ::pclose(pipe);
+  run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
+  return run;
+}
+
+inline void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+inline std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+inline fs::path shared_meshes() { return DIEFILL_SHARED_MESHES; }
+inline fs::path source_dir() { return DIEFILL_SOURCE_DIR; }
+
+#define REQUIRE_SHARED_MESHES()                                                             \
+  if (!std::filesystem::exists(test::shared_meshes() / "dies"))                            \
+  GTEST_SKIP() << "shared meshes not found at " << test::shared_meshes()                     \
+               << " (configure with -DDIEFILL_SHARED_MESHES=...)"
+
+}  // namespace test

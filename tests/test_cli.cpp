@@ -1,0 +1,89 @@
+// The command line: version, and bad input of every kind ends with a clear message and exit
+// status 2 (run under AddressSanitizer and UBSan by scripts/test.sh).
+#include <gtest/gtest.h>
+
+#include "mesh/import.hpp"
+#include "mesh/shapes.hpp"
+#include "meshes.hpp"
+#include "support.hpp"
+
+namespace {
+
+// Expects exit status 2 and a message that names `file` and contains `words`.
+void expect_bad_input(const std::string& arguments, const std::string& file, const std::string& words) {
+  const test::Run run = test::run_diefill(arguments);
+  EXPECT_EQ(run.status, 2) << arguments << "\n" << run.output;
+  EXPECT_NE(run.output.find(file), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find(words), std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("Sanitizer"), std::string::npos) << run.output;
+}
+
+}  // namespace
+
+TEST(Cli, VersionListsTheLibraries) {
+  const test::Run run = test::run_diefill("--version");
+  EXPECT_EQ(run.status, 0);
+  for (const char* library : {"diefill", "CGAL 5.", "OpenVDB 10.", "assimp 5.", "Embree 3.", "Eigen 3."})
+    EXPECT_NE(run.output.find(library), std::string::npos) << library << "\n" << run.output;
+}
+
+TEST(Cli, UnknownOptionIsBadInput) {
+  EXPECT_EQ(test::run_diefill("sdf --no-such-option x.stl").status, 2);
+}
+
+TEST(Cli, SdfRejectsBadMeshesClearly) {
+  test::TempDir dir;
+  const std::string d = dir.path().string();
+  const mesh::TriMesh ring = mesh::bundled_die("ring");
+  mesh::write_stl(ring, dir / "ring.stl", mesh::LengthUnit::mm, "ring");
+  const std::string whole = test::read_text(dir / "ring.stl");
+
+  expect_bad_input("sdf " + d + "/missing.stl", "missing.stl", "no such file");
+  expect_bad_input("sdf " + d, d, "is a directory");
+  test::write_text(dir / "empty.stl", "");
+  expect_bad_input("sdf " + d + "/empty.stl", "empty.stl", "empty");
+  test::write_text(dir / "truncated.stl", whole.substr(0, whole.size() / 2));
+  expect_bad_input("sdf " + d + "/truncated.stl", "truncated.stl", "not a readable mesh");
+  test::write_text(dir / "garbage.stl", "solid? no. \x7f\x01 random words, not facets\n");
+  expect_bad_input("sdf " + d + "/garbage.stl", "garbage.stl", "not a readable mesh");
+  std::string nan_solid = test::ascii_stl(test::box_mm(0, 10));
+  nan_solid.replace(nan_solid.find("vertex ") + 7, 1, "nan");
+  test::write_text(dir / "nan.stl", nan_solid);
+  expect_bad_input("sdf " + d + "/nan.stl", "nan.stl", "not a finite number");
+  test::write_text(dir / "triangle.stl",
+                   "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                   "endloop\nendfacet\nendsolid t\n");
+  expect_bad_input("sdf " + d + "/triangle.stl", "triangle.stl", "cannot enclose a solid");
+  mesh::TriMesh open_box = test::box_mm(0, 10);
+  open_box.triangles.resize(10);
+  test::write_text(dir / "open_box.stl", test::ascii_stl(open_box));
+  expect_bad_input("sdf --role tool " + d + "/open_box.stl", "open_box.stl", "boundary edges");
+  test::write_text(dir / "nested.stl", test::ascii_stl(test::joined(test::box_mm(0, 10), test::box_mm(2, 8))));
+  expect_bad_input("sdf --role tool " + d + "/nested.stl", "nested.stl", "inside another shell");
+  mesh::write_stl(ring, dir / "ring_in_metres.stl", mesh::LengthUnit::m, "ring, m");
+  expect_bad_input("sdf " + d + "/ring_in_metres.stl", "ring_in_metres.stl", "--units m");
+  expect_bad_input("sdf --units furlong " + d + "/ring.stl", "--units", "unknown length unit");
+  expect_bad_input("sdf --voxel -1 " + d + "/ring.stl", "voxel", "positive");
+}
+
+TEST(Cli, SdfRepairsFlippedNormalsAndSaysSo) {
+  test::TempDir dir;
+  test::write_text(dir / "flipped.stl", test::ascii_stl(test::reversed(test::box_mm(0, 10))));
+  const test::Run run = test::run_diefill("sdf --role tool " + (dir / "flipped.stl").string() + " -o " +
+                                          (dir / "flipped.vdb").string());
+  EXPECT_EQ(run.status, 0) << run.output;
+  EXPECT_NE(run.output.find("orientation          inward"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("oriented every shell outward"), std::string::npos) << run.output;
+  EXPECT_TRUE(std::filesystem::exists(dir / "flipped.vdb"));
+}
+
+TEST(Cli, FailedSdfKeepsTheEarlierOutput) {
+  test::TempDir dir;
+  mesh::write_stl(mesh::bundled_die("disc"), dir / "disc.stl", mesh::LengthUnit::mm, "disc");
+  const std::string out = (dir / "disc.vdb").string();
+  ASSERT_EQ(test::run_diefill("sdf " + (dir / "disc.stl").string() + " -o " + out).status, 0);
+  const std::string before = test::read_text(out);
+  test::write_text(dir / "disc.stl", "garbage");
+  EXPECT_EQ(test::run_diefill("sdf " + (dir / "disc.stl").string() + " -o " + out).status, 2);
+  EXPECT_EQ(test::read_text(out), before);
+}

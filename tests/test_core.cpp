@@ -1,0 +1,37 @@
+// core: hashing and atomic output.
+#include <gtest/gtest.h>
+
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "core/sha256.hpp"
+#include "support.hpp"
+
+TEST(Sha256, MatchesFipsVectors) {
+  EXPECT_EQ(diefill::sha256_hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(diefill::sha256_hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(diefill::sha256_hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
+            "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+  // A million 'a': crosses many blocks and the padding boundary.
+  EXPECT_EQ(diefill::sha256_hex(std::string(1000000, 'a')),
+            "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+}
+
+TEST(AtomicFile, ReplacesOnlyWhenComplete) {
+  test::TempDir dir;
+  const auto target = dir / "out.txt";
+  diefill::write_file_atomic(target, "first");
+  {
+    diefill::PendingFile pending(target);
+    test::write_text(pending.path(), "half-written");
+    // Destroyed without commit: the earlier output stays and no temporary is left behind.
+  }
+  EXPECT_EQ(test::read_text(target), "first");
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()),
+                          std::filesystem::directory_iterator()),
+            1);
+}
+
+TEST(InputError, NamesFileFieldAndRemedy) {
+  const diefill::InputError e("scene.toml", "simulation.duration", "must be positive", "Give a duration in seconds");
+  EXPECT_STREQ(e.what(), "scene.toml: simulation.duration: must be positive. Give a duration in seconds");
+}

@@ -1,0 +1,141 @@
+// Conservation and reproducibility: energy and momentum in a gas of elastic grains,
+// bit-identical states for any thread count and across a checkpoint.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include "core/error.hpp"
+#include "dem/checkpoint.hpp"
+#include "dem/insert.hpp"
+#include "dem_support.hpp"
+#include "dem/forces.hpp"
+#include "support.hpp"
+
+using dem::Vec3;
+
+namespace {
+
+// Elastic, frictionless grains with random velocities in a box of planes.
+dem::ModelSpec gas_spec(bool walls) {
+  dem::ModelSpec spec = test::spec_with({test::glass(1.0, 0.0), test::rigid_wall(1.0, 0.0)});
+  spec.tangential = dem::TangentialLaw::none;
+  spec.max_impact_speed = 1.0;
+  spec.time_step_fraction = 0.02;
+  spec.domain.lo = Vec3::Constant(-6e-3);
+  spec.domain.hi = Vec3::Constant(6e-3);
+  if (walls)
+    for (int a = 0; a < 3; ++a)
+      for (int side : {-1, 1}) {
+        Vec3 n = Vec3::Zero();
+        n[a] = -side;
+        spec.planes.push_back({Vec3::Unit(a) * side * 5e-3, n, 1, "box"});
+      }
+  return spec;
+}
+
+dem::State gas(std::size_t count, std::uint64_t seed, double speed) {
+  dem::State s;
+  dem::InsertRegion region;
+  region.box = {Vec3::Constant(-4.9e-3), Vec3::Constant(4.9e-3)};
+  dem::InsertRequest req;
+  req.count = count;
+  req.radius = 0.3e-3;
+  req.radius_spread = 0.2;
+  req.seed = seed;
+  dem::insert_spheres(s, region, req);
+  dem::Random random(seed + 1);
+  for (Vec3& v : s.v) v = speed * Vec3(random.uniform(-1, 1), random.uniform(-1, 1), random.uniform(-1, 1));
+  return s;
+}
+
+// Counts pair contacts that begin during the run.
+std::int64_t run_counting_collisions(const dem::Model& model, dem::State& s, std::int64_t collisions) {
+  std::int64_t begun = 0, previous = s.counters.contacts;
+  while (begun < collisions) {
+    dem::step(model, s);
+    begun += std::max<std::int64_t>(0, s.counters.contacts - previous);
+    previous = s.counters.contacts;
+  }
+  return begun;
+}
+
+}  // namespace
+
+TEST(Conservation, ElasticGasKeepsItsEnergy) {
+  const dem::ModelSpec spec = gas_spec(true);
+  dem::State s = gas(300, 3, 0.5);
+  const dem::Model model = dem::compile_model(spec, s, "gas");
+  dem::initialize(model, s);
+  const double e0 = dem::kinetic_energy(s) + dem::elastic_energy(model, s);
+  const std::int64_t collisions = run_counting_collisions(model, s, 1000);
+  // Measured when no contact is active, so that no energy sits in a spring.
+  while (s.counters.contacts + s.counters.wall_contacts > 0) dem::step(model, s);
+  const double e1 = dem::kinetic_energy(s);
+  EXPECT_GE(collisions, 1000);
+  EXPECT_LT(std::abs(e1 - e0) / e0, 1e-4) << "after " << collisions << " collisions";
+}
+
+TEST(Conservation, CollisionsConserveMomentum) {
+  // No walls, no gravity: grains fly through each other's paths; every collision exchanges
+  // equal and opposite impulses.
+  dem::ModelSpec spec = gas_spec(false);
+  spec.domain.lo = Vec3::Constant(-1);
+  spec.domain.hi = Vec3::Constant(1);
+  dem::State s = gas(300, 5, 0.5);
+  const dem::Model model = dem::compile_model(spec, s, "gas");
+  dem::initialize(model, s);
+  auto momentum = [&] {
+    Vec3 p = Vec3::Zero();
+    double scale = 0;
+    for (std::size_t i = 0; i < s.size(); ++i) p += s.mass[i] * s.v[i], scale += s.mass[i] * s.v[i].norm();
+    return std::pair{p, scale};
+  };
+  const auto [p0, scale] = momentum();
+  std::int64_t contacts = 0;
+  for (int n = 0; n < 3000; ++n) {
+    dem::step(model, s);
+    contacts += s.counters.contacts;
+    EXPECT_LT((momentum().first - p0).norm() / scale, 1e-14) << "step " << n;
+  }
+  EXPECT_GT(contacts, 0);
+}
+
+TEST(Reproducibility, ThreadCountDoesNotChangeTheState) {
+  const dem::ModelSpec spec = gas_spec(true);
+  auto run = [&](int threads) {
+    omp_set_num_threads(threads);
+    dem::State s = gas(400, 9, 0.3);
+    dem::ModelSpec with_gravity = spec;
+    with_gravity.gravity = Vec3(0, 0, -9.81);
+    with_gravity.materials[0].sliding_friction = 0.4;
+    with_gravity.tangential = dem::TangentialLaw::mindlin;
+    const dem::Model model = dem::compile_model(with_gravity, s, "gas");
+    dem::initialize(model, s);
+    for (int n = 0; n < 2000; ++n) dem::step(model, s);
+    return dem::state_hash(s);
+  };
+  const int all = omp_get_max_threads();
+  const std::string one = run(1), two = run(2), many = run(std::max(3, all));
+  omp_set_num_threads(all);
+  EXPECT_EQ(one, two);
+  EXPECT_EQ(one, many);
+}
+
+TEST(Reproducibility, ResumedRunMatchesTheUninterruptedOne) {
+  test::TempDir dir;
+  dem::ModelSpec spec = gas_spec(true);
+  spec.gravity = Vec3(0, 0, -9.81);
+  spec.materials[0].sliding_friction = 0.4;
+  spec.tangential = dem::TangentialLaw::mindlin;
+  dem::State a = gas(300, 4, 0.3);
+  const dem::Model model = dem::compile_model(spec, a, "gas");
+  dem::initialize(model, a);
+  for (int n = 0; n < 700; ++n) dem::step(model, a);
+  dem::write_checkpoint(model, a, dir / "run.ckpt");
+  for (int n = 0; n < 700; ++n) dem::step(model, a);
+  dem::State b = dem::read_checkpoint(model, dir / "run.ckpt");
+  for (int n = 0; n < 700; ++n) dem::step(model, b);
+  EXPECT_EQ(dem::state_hash(a), dem::state_hash(b));
+  dem::ModelSpec other = spec;
+  other.materials[0].sliding_friction = 0.5;
+  EXPECT_THROW(dem::read_checkpoint(dem::compile_model(other, b, "gas"), dir / "run.ckpt"), diefill::InputError);
+}

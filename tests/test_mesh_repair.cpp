@@ -1,0 +1,144 @@
+// mesh/repair and mesh/tool: what the checks count, what repair changes, what it refuses.
+#include <gtest/gtest.h>
+
+#include "core/error.hpp"
+#include "mesh/import.hpp"
+#include "mesh/repair.hpp"
+#include "mesh/shapes.hpp"
+#include "mesh/tool.hpp"
+#include "meshes.hpp"
+
+using mesh::Vec3;
+
+namespace {
+
+mesh::RepairOptions options_mm(double tolerance_mm = 0.05, double max_hole_mm = 2.0) {
+  mesh::RepairOptions o;
+  o.tolerance_m = tolerance_mm * 1e-3;
+  o.max_hole_m = max_hole_mm * 1e-3;
+  return o;
+}
+
+std::string repair_error(const mesh::TriMesh& m, const mesh::RepairOptions& o = options_mm()) {
+  try {
+    mesh::repair(m, o, "part.stl");
+  } catch (const diefill::InputError& e) {
+    return e.field() + " | " + e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(Inspect, CountsDefects) {
+  mesh::TriMesh box = test::box_mm(0, 10);
+  const mesh::MeshReport clean = mesh::inspect(box);
+  EXPECT_TRUE(clean.closed);
+  EXPECT_EQ(clean.orientation, "outward");
+  EXPECT_EQ(clean.shells, 1u);
+  EXPECT_EQ(clean.self_intersections, 0u);
+  EXPECT_NEAR(clean.volume_m3, 1e-6, 1e-15);
+  EXPECT_NEAR(clean.area_m2, 6e-4, 1e-15);
+
+  mesh::TriMesh open = box;
+  open.triangles.pop_back();
+  EXPECT_EQ(mesh::inspect(open).boundary_edges, 3u);
+  EXPECT_FALSE(mesh::inspect(open).closed);
+
+  mesh::TriMesh flipped_face = box;
+  std::swap(flipped_face.triangles[0][1], flipped_face.triangles[0][2]);
+  EXPECT_EQ(mesh::inspect(flipped_face).inconsistent_edges, 3u);
+  EXPECT_EQ(mesh::inspect(flipped_face).orientation, "inconsistent");
+
+  mesh::TriMesh fin = box;  // a third triangle on a box edge: non-manifold
+  fin.vertices.emplace_back(-5e-3, -5e-3, 5e-3);
+  fin.triangles.push_back({0, 1, 8});
+  EXPECT_EQ(mesh::inspect(fin).non_manifold_edges, 1u);
+
+  mesh::TriMesh sliver = box;  // zero area: collinear points, and a repeated index
+  sliver.vertices.emplace_back(5e-3, 0, 0);
+  sliver.triangles.push_back({0, 8, 1});
+  sliver.triangles.push_back({0, 0, 1});
+  EXPECT_EQ(mesh::inspect(sliver).degenerate_faces, 2u);
+
+  const mesh::TriMesh overlapping = test::joined(box, test::box_mm(5, 15));
+  EXPECT_EQ(mesh::inspect(overlapping).shells, 2u);
+  EXPECT_GT(mesh::inspect(overlapping).self_intersections, 0u);
+  mesh::TriMesh twice = test::joined(box, box);
+  mesh::weld_exact(twice);
+  EXPECT_EQ(mesh::inspect(twice).duplicate_faces, 12u);
+}
+
+TEST(Repair, LeavesACleanSolidAlone) {
+  const mesh::RepairResult r = mesh::repair(test::box_mm(0, 10), options_mm(), "box.stl");
+  EXPECT_FALSE(r.repaired);
+  EXPECT_TRUE(r.actions.empty());
+  EXPECT_EQ(r.hausdorff_m, 0.0);
+}
+
+TEST(Repair, OrientsFlippedNormalsOutward) {
+  const mesh::RepairResult r = mesh::repair(test::reversed(test::box_mm(0, 10)), options_mm(), "box.stl");
+  EXPECT_EQ(r.before.orientation, "inward");
+  EXPECT_EQ(r.after.orientation, "outward");
+  EXPECT_NEAR(r.after.volume_m3, 1e-6, 1e-15);
+  EXPECT_TRUE(r.repaired);
+}
+
+TEST(Repair, MakesDoubleSidedSurfacesSingle) {
+  const mesh::TriMesh box = test::box_mm(0, 10);
+  const mesh::RepairResult r = mesh::repair(test::joined(box, test::reversed(box)), options_mm(), "box.stl");
+  EXPECT_EQ(r.after.triangles, 12u);
+  EXPECT_NEAR(r.after.volume_m3, 1e-6, 1e-15);
+}
+
+TEST(Repair, FillsASmallHoleWithoutMovingTheSurface) {
+  // A 10 mm box whose top is split finely, one small triangle missing.
+  mesh::TriMesh m = test::box_mm(0, 10);
+  m.triangles.pop_back();  // a whole half face: 14 mm across, larger than max_hole
+  EXPECT_EQ(repair_error(m).rfind("boundary edges", 0), 0u) << repair_error(m);
+  const mesh::RepairResult r = mesh::repair(m, options_mm(0.05, 20.0), "box.stl");
+  EXPECT_EQ(r.holes_filled, 1u);
+  EXPECT_TRUE(r.after.closed);
+  EXPECT_NEAR(r.after.volume_m3, 1e-6, 1e-15);
+  EXPECT_LT(r.hausdorff_m, 1e-12) << "the existing surface does not move";
+  // The point of the missing triangle farthest from the rest is its incentre, an inradius away.
+  EXPECT_NEAR(r.bridged_m, 10e-3 * (2 - std::sqrt(2.0)) / 2, 0.3e-3) << "the fill spans the missing triangle";
+}
+
+TEST(Repair, UnitesIntersectingShellsExactly) {
+  const mesh::RepairResult r =
+      mesh::repair(test::joined(test::box_mm(0, 10), test::box_mm(5, 15)), options_mm(), "two.stl");
+  EXPECT_TRUE(r.after.closed);
+  EXPECT_EQ(r.after.self_intersections, 0u);
+  EXPECT_EQ(r.after.shells, 1u);
+  EXPECT_NEAR(r.after.volume_m3, (1000.0 + 1000.0 - 125.0) * 1e-9, 1e-15);
+  EXPECT_FALSE(r.wrapped);
+}
+
+TEST(Repair, RefusesWhatItCannotRepairWithinTolerance) {
+  EXPECT_EQ(repair_error(mesh::TriMesh{{Vec3(0, 0, 0), Vec3(1e-3, 0, 0), Vec3(0, 1e-3, 0)}, {{0, 1, 2}}})
+                .rfind("triangles", 0),
+            0u);
+  mesh::TriMesh open_box = test::box_mm(0, 10);
+  open_box.triangles.resize(10);  // one face missing
+  EXPECT_EQ(repair_error(open_box).rfind("boundary edges", 0), 0u) << repair_error(open_box);
+  const mesh::TriMesh nested = test::joined(test::box_mm(0, 10), test::box_mm(2, 8));
+  EXPECT_EQ(repair_error(nested).rfind("shells", 0), 0u) << repair_error(nested);
+}
+
+TEST(Tool, IsTheTableBlockMinusTheCavity) {
+  const mesh::TriMesh ring = mesh::bundled_die("ring");
+  const mesh::TableExtent table{-20e-3, -15e-3, 25e-3, 15e-3, 5e-3};
+  const mesh::ToolMesh tool = mesh::tool_from_cavity(ring, table, "ring.stl");
+  EXPECT_DOUBLE_EQ(tool.table_z, 0.0);
+  const double block = 45e-3 * 30e-3 * 15e-3;
+  EXPECT_NEAR(mesh::signed_volume(tool.mesh), block - mesh::signed_volume(ring), 1e-15);
+  const mesh::MeshReport report = mesh::inspect(tool.mesh);
+  EXPECT_TRUE(report.closed);
+  EXPECT_EQ(report.orientation, "outward");
+  EXPECT_EQ(report.self_intersections, 0u);
+  EXPECT_EQ(report.shells, 1u);
+  // The core of the ring is a table island: the tool's top includes it.
+  EXPECT_THROW(mesh::tool_from_cavity(ring, {-5e-3, -5e-3, 5e-3, 5e-3, 1e-3}, "ring.stl"),
+               diefill::InputError);
+}

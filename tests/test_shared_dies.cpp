@@ -1,0 +1,88 @@
+// Every die mesh of ../shared/data/meshes/dies either loads, repairs and passes the sign check,
+// or stops with an error naming its defect. The table is the record of which did which.
+#include <gtest/gtest.h>
+
+#include "core/error.hpp"
+#include "mesh/die.hpp"
+#include "mesh/exact.hpp"
+#include "mesh/verify.hpp"
+#include "support.hpp"
+
+namespace {
+
+struct SharedDie {
+  const char* file;
+  mesh::LengthUnit unit;  // from SOURCES.md: files store none
+  const char* defect;     // nullptr: must load; else the error must name this
+};
+
+// Why each refused mesh is refused, in the words the error must contain.
+const SharedDie shared_dies[] = {
+    {"blind_flange_disc_trimesh_counter_mm.stl", mesh::LengthUnit::mm, nullptr},  // 6 shells united
+    {"stepped_bushing_gazebo_coupling_doublesided.stl", mesh::LengthUnit::mm, nullptr},  // made single-sided
+    {"large_turbineblade_vtk_199k.ply", mesh::LengthUnit::mm, nullptr},
+    {"flanged_ring_trimesh_idler_riser.stl", mesh::LengthUnit::in, "boundary edges"},  // 71 mm opening
+    {"gear_8tooth_open_thingi10k_50736.stl", mesh::LengthUnit::mm, "boundary edges"},  // 19.5 mm hole
+    {"sprocket_hub_chrono_m113_singlepin.obj", mesh::LengthUnit::m, "boundary edges"},  // open visual mesh
+    {"planetary_gearset_vtk_gears.stl", mesh::LengthUnit::mm, "intersecting triangles"},  // a shell crosses itself
+    {"toothed_pulley_hub_trimesh_cycloidal.ply", mesh::LengthUnit::in, "non-manifold edges"},
+    {"broken/assimp_3DSMaxExport.stl", mesh::LengthUnit::mm, "non-manifold edges"},
+    {"broken/assimp_Spider_ascii.stl", mesh::LengthUnit::mm, "boundary edges"},
+    {"broken/assimp_sphereWithHole.stl", mesh::LengthUnit::mm, "boundary edges"},
+    {"broken/assimp_triangle_with_two_solids.stl", mesh::LengthUnit::mm, "cannot enclose a solid"},
+    {"broken/numpystl_StarWithEmptyHeader.stl", mesh::LengthUnit::mm, nullptr},
+    {"broken/trimesh_featuretype_badheader_open.stl", mesh::LengthUnit::in, "boundary edges"},
+    {"broken/trimesh_soup.stl", mesh::LengthUnit::mm, "boundary edges"},
+    {"broken/trimesh_stl_empty_ascii.stl", mesh::LengthUnit::mm, "not a readable mesh"},
+    {"broken/trimesh_stl_empty_bin.stl", mesh::LengthUnit::mm, "not a readable mesh"},
+};
+
+void PrintTo(const SharedDie& d, std::ostream* os) { *os << d.file; }
+
+}  // namespace
+
+class SharedDieMesh : public ::testing::TestWithParam<SharedDie> {};
+
+TEST_P(SharedDieMesh, LoadsAndPassesTheSignCheckOrNamesItsDefect) {
+  REQUIRE_SHARED_MESHES();
+  const SharedDie& d = GetParam();
+  const auto path = test::shared_meshes() / "dies" / d.file;
+  // A voxel of at least 1/300 of the part keeps the large parts affordable in a test.
+  double voxel = 0.125e-3;
+  try {
+    voxel = std::max(voxel, mesh::bounding_box(mesh::import_mesh(path, {d.unit}).mesh).size().maxCoeff() / 300);
+  } catch (const diefill::InputError&) {
+    // prepare_die below reports it
+  }
+  mesh::DieOptions o = mesh::die_options_for_grains(0.5e-3, 0.25e-3, voxel);
+  o.unit = d.unit;
+  o.role = mesh::WallRole::tool;
+  if (d.defect == nullptr) {
+    const mesh::PreparedDie sized = mesh::prepare_die(path, o, std::nullopt);
+    const mesh::ExactSurface exact(sized.solid);
+    const mesh::SdfVerification v =
+        mesh::verify_sdf(sized.sdf.wall_field(sized.solid), sized.solid, exact, 3000, 3);
+    EXPECT_EQ(v.samples, 3000u) << d.file;
+    EXPECT_EQ(v.query.sign_disagreements, 0u) << d.file;
+    EXPECT_LE(v.query.max_smooth_voxels, 0.05) << d.file;
+    std::printf("%-52s loads: %zu triangles, repairs: %zu, query max error %.2g voxel\n", d.file,
+                sized.after.triangles, sized.actions.size(), v.query.max_voxels);
+  } else {
+    try {
+      mesh::prepare_die(path, o, std::nullopt);
+      ADD_FAILURE() << d.file << " was accepted; expected an error naming " << d.defect;
+    } catch (const diefill::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(d.defect), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(d.file), std::string::npos) << e.what();
+      std::printf("%-52s refused: %.160s\n", d.file, e.what());
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(All, SharedDieMesh, ::testing::ValuesIn(shared_dies),
+                         [](const ::testing::TestParamInfo<SharedDie>& info) {
+                           std::string name = info.param.file;
+                           for (char& c : name)
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           return name;
+                         });
