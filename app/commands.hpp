@@ -34,6 +34,26 @@ struct RunCommand {
 };
 int run_pipeline(const RunCommand& command);
 
+struct SimulateCommand {
+  std::filesystem::path scene;
+  std::filesystem::path out;  // overrides output.directory
+  std::vector<std::string> overrides;
+  std::optional<int> threads;
+  bool resume = false;
+};
+int run_simulate(const SimulateCommand& command);
+
+struct BenchCommand {
+  std::vector<std::string> cases;
+  std::filesystem::path json_out;
+  std::vector<int> threads;
+  int steps = 2000;
+  std::filesystem::path cache = "out/bench";
+  std::filesystem::path pack;  // liggghts: the settled pack (LAMMPS dump)
+  std::filesystem::path stl;   // liggghts: the container (mm)
+};
+int run_bench(const BenchCommand& command);
+
 struct DieCommand {
   std::string name;  // bundled die
   std::filesystem::path output;

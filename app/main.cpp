@@ -14,7 +14,7 @@ void add_sdf(CLI::App& root, app::SdfCommand& c, std::function<int()>& action) {
   cmd->add_option("-o,--output", c.output, "Output .vdb file");
   cmd->add_option("--voxel", c.voxel_mm, "Voxel edge [mm] (default: a quarter of the grain radius)");
   cmd->add_option("--units", c.units, "Length unit of the file: mm, m or in")->capture_default_str();
-  cmd->add_option("--role", c.role, "cavity (the part, open at the table) or tool (the die body)")
+  cmd->add_option("--role", c.role, "cavity (the part, open at the table), tool (the die body) or container (a closed vessel)")
       ->capture_default_str();
   cmd->add_option("--grain-radius", c.grain_radius_mm, "Largest grain radius [mm]")->capture_default_str();
   cmd->add_option("--skin", c.skin_mm, "Neighbour skin [mm]")->capture_default_str();
@@ -32,6 +32,28 @@ void add_run(CLI::App& root, app::RunCommand& c, std::function<int()>& action) {
   cmd->add_option("--out", c.out, "Output folder; each die writes into OUT/<die name>/")->capture_default_str();
   cmd->add_option("--units", c.units, "Length unit of the meshes: mm, m or in")->capture_default_str();
   cmd->callback([&] { action = [&] { return app::run_pipeline(c); }; });
+}
+
+void add_simulate(CLI::App& root, app::SimulateCommand& c, std::function<int()>& action) {
+  CLI::App* cmd = root.add_subcommand("simulate", "Run a general DEM scene (explicit particles, walls, motions)");
+  cmd->add_option("SCENE", c.scene, "Scene file (TOML)")->required();
+  cmd->add_option("--out", c.out, "Output folder (overrides output.directory)");
+  cmd->add_option("--set", c.overrides, "Override a scene key: --set simulation.duration=0.01");
+  cmd->add_option("--threads", c.threads, "Threads (default: all cores)");
+  cmd->add_flag("--resume", c.resume, "Continue from the output folder's checkpoint");
+  cmd->callback([&] { action = [&] { return app::run_simulate(c); }; });
+}
+
+void add_bench(CLI::App& root, app::BenchCommand& c, std::function<int()>& action) {
+  CLI::App* cmd = root.add_subcommand("bench", "Performance cases; JSON results");
+  cmd->add_option("CASE", c.cases, "ring-10k, ring-100k (default both), liggghts");
+  cmd->add_option("--json", c.json_out, "Write the results here instead of standard output");
+  cmd->add_option("--threads", c.threads, "Thread counts to time (default 1 2)");
+  cmd->add_option("--steps", c.steps, "Timed steps per run")->capture_default_str();
+  cmd->add_option("--cache", c.cache, "Folder for prepared packs and SDFs")->capture_default_str();
+  cmd->add_option("--pack", c.pack, "liggghts: settled pack (LAMMPS dump: id x y z radius vx vy vz)");
+  cmd->add_option("--stl", c.stl, "liggghts: container mesh (mm)");
+  cmd->callback([&] { action = [&] { return app::run_bench(c); }; });
 }
 
 void add_die(CLI::App& root, app::DieCommand& c, std::function<int()>& action) {
@@ -57,6 +79,10 @@ int main(int argc, char** argv) {
   app::DieCommand die;
   app::RunCommand run;
   add_run(root, run, action);
+  app::SimulateCommand simulate;
+  add_simulate(root, simulate, action);
+  app::BenchCommand bench;
+  add_bench(root, bench, action);
   add_sdf(root, sdf, action);
   add_die(root, die, action);
   try {

@@ -58,18 +58,13 @@ void fields(IO& io, S& s) {
   io.array(nl.row_start);
   io.array(nl.partner);
   io.array(nl.history);
+  io.array(nl.touching);
   io.array(nl.reverse_start);
   io.array(nl.reverse_pair);
   io.array(nl.near_wall);
   io.array(nl.x_at_build);
   io.array(nl.wall_shift_at_build);
   io.value(nl.builds);
-  auto& pf = s.pair_forces;
-  io.array(pf.force);
-  io.array(pf.moment);
-  io.array(pf.rolling);
-  io.array(pf.arm_i);
-  io.array(pf.arm_j);
   io.value(s.time);
   io.value(s.step);
   io.value(s.lost);
@@ -103,6 +98,9 @@ State read_checkpoint(const Model& model, const std::filesystem::path& path) {
   State s;
   fields(r, s);
   if (!r.in) throw diefill::InputError(path.string(), "", "the checkpoint is truncated", "Start afresh");
+  // Per-pair force buffers are scratch, refilled by the next force stage.
+  s.pair_forces.force.assign(s.neighbours.partner.size(), Vec3::Zero());
+  s.pair_forces.torque.assign(s.neighbours.partner.size(), Vec3::Zero());
   return s;
 }
 

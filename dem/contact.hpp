@@ -21,6 +21,8 @@ struct PairParams {
   double mu_s = 0;         // sliding friction
   double mu_r = 0;         // rolling friction (dimensionless)
   double k_linear = 0;     // linear normal stiffness [N/m] (linear law)
+  double kt_over_kn = 0;   // tangential over normal stiffness, 4 G*/E* (Mindlin: S_t = 8 G* a, S_n = 2 E* a)
+  double sqrt_kt_over_kn = 0;
   double cohesion = 0;     // SJKR cohesion energy density [J/m³ = N/m²]
 };
 
@@ -48,7 +50,7 @@ struct ContactHistory {
 struct ContactForce {
   Vec3 force;           // on body i [N]
   Vec3 rolling_torque;  // on body i [N m] (the partner gets the opposite)
-  double normal;        // magnitude of the normal force, for monitors [N]
+  double normal;        // magnitude of the repulsive normal force [N]
 };
 
 // ---- normal slot ------------------------------------------------------------------------
@@ -70,25 +72,23 @@ struct LinearNormal {
 // ---- tangential slot --------------------------------------------------------------------
 struct MindlinTangential {
   static constexpr bool active = true;
-  // Tangential force on i, updating the spring; `normal_force` is the (non-negative) normal
-  // force the Coulomb cap uses, `gamma_scale` the damping coefficient per sqrt(stiffness).
+  // Tangential force on i, updating the spring ξ. S_t = 8 G* sqrt(R* δ) = (4 G*/E*) S_n, damped
+  // like the normal part (γ_t = sqrt(S_t/S_n) γ_n); `normal_force` (non-negative) sets the
+  // Coulomb cap.
   static Vec3 eval(const PairParams& p, const ContactKinematics& c, double normal_force,
-                   double gamma_scale, double dt, Vec3& spring) {
+                   double normal_stiffness, double normal_gamma, double dt, Vec3& spring) {
     const Vec3 vt = c.v_rel - c.n * c.n.dot(c.v_rel);
-    // Keep the spring in the current tangent plane, preserving its length.
-    const double length = spring.norm();
+    // Keep the spring in the current tangent plane. Its length is not restored: the rotation
+    // per step is of order 1e-4 rad, so the length lost is of order 1e-8 per step.
     spring -= c.n * c.n.dot(spring);
-    const double projected = spring.norm();
-    if (projected > 0) spring *= length / projected;
     spring += vt * dt;
-    const double kt = 8.0 * p.g_star * std::sqrt(c.r_eff * c.overlap);  // S_t = 8 G* sqrt(R* δ)
-    const double gamma = gamma_scale * std::sqrt(kt * c.m_eff);
-    Vec3 force = -kt * spring - gamma * vt;
+    const double kt = p.kt_over_kn * normal_stiffness;
+    Vec3 force = -kt * spring - (p.sqrt_kt_over_kn * normal_gamma) * vt;
     const double cap = p.mu_s * normal_force;
-    const double magnitude = force.norm();
-    if (magnitude > cap) {
+    const double magnitude2 = force.squaredNorm();
+    if (magnitude2 > cap * cap) {
       // Gross sliding: the force sits on the Coulomb cap and the spring is reset to it.
-      force *= cap / magnitude;
+      force *= cap / std::sqrt(magnitude2);
       spring = kt > 0 ? Vec3(-force / kt) : Vec3(Vec3::Zero());
     }
     return force;
@@ -96,7 +96,7 @@ struct MindlinTangential {
 };
 struct NoTangential {
   static constexpr bool active = false;
-  static Vec3 eval(const PairParams&, const ContactKinematics&, double, double, double, Vec3&) {
+  static Vec3 eval(const PairParams&, const ContactKinematics&, double, double, double, double, Vec3&) {
     return Vec3::Zero();
   }
 };
@@ -109,15 +109,12 @@ struct EpsdRolling {
   static Vec3 eval(const PairParams& p, const ContactKinematics& c, double normal_force,
                    double normal_stiffness, double dt, Vec3& torque) {
     const Vec3 w_roll = c.w_rel - c.n * c.n.dot(c.w_rel);
-    const double length = torque.norm();
-    torque -= c.n * c.n.dot(torque);
-    const double projected = torque.norm();
-    if (projected > 0) torque *= length / projected;
+    torque -= c.n * c.n.dot(torque);  // into the tangent plane, as the tangential spring
     const double kr = 2.25 * normal_stiffness * p.mu_r * p.mu_r * c.r_eff * c.r_eff;
     torque -= kr * w_roll * dt;
     const double cap = p.mu_r * c.r_eff * normal_force;
-    const double magnitude = torque.norm();
-    if (magnitude > cap) torque *= cap / magnitude;
+    const double magnitude2 = torque.squaredNorm();
+    if (magnitude2 > cap * cap) torque *= cap / std::sqrt(magnitude2);
     return torque;
   }
 };
@@ -166,7 +163,7 @@ struct ContactLaw {
     ContactForce out;
     out.normal = repulsive;
     out.force = c.n * normal;
-    out.force += Tangential::eval(p, c, repulsive, p.damping, dt, h.tangential);
+    out.force += Tangential::eval(p, c, repulsive, stiffness, gamma, dt, h.tangential);
     out.rolling_torque = Rolling::eval(p, c, repulsive, stiffness, dt, h.rolling);
     return out;
   }

@@ -6,6 +6,8 @@ namespace dem {
 
 namespace {
 
+// Rows in parallel: the owner i sums its own share (gravity first, then its pairs in order)
+// straight into f[i]; the partner's share goes to the pair buffer.
 template <class Law>
 void pair_forces(const Model& model, State& s) {
   NeighbourList& nl = s.neighbours;
@@ -16,25 +18,38 @@ void pair_forces(const Model& model, State& s) {
   std::int64_t contacts = 0;
 #pragma omp parallel for schedule(dynamic, 512) reduction(max : max_overlap) reduction(+ : contacts)
   for (std::size_t i = 0; i < n; ++i) {
+    const std::int32_t first = nl.row_start[i], last = nl.row_start[i + 1];
+    if (!s.active[i]) {
+      s.f[i].setZero();
+      s.torque[i].setZero();
+      continue;  // an inactive grain has no listed pairs
+    }
     const Vec3 xi = s.x[i], vi = s.v[i], wi = s.w[i];
     const double ri = s.radius[i], mi = s.mass[i];
     const int mat_i = s.material[i];
-    for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p) {
+    Vec3 fi = mi * model.gravity, ti = Vec3::Zero();
+    for (std::int32_t p = first; p < last; ++p) {
       const std::size_t j = std::size_t(nl.partner[std::size_t(p)]);
       const Vec3 d = xi - s.x[j];
       const double reach = ri + s.radius[j];
       const double dist2 = d.squaredNorm();
-      ContactHistory& h = nl.history[std::size_t(p)];
-      if (dist2 >= reach * reach || !s.active[j] || !s.active[i]) {
-        h = ContactHistory{};
-        pf.force[std::size_t(p)].setZero();
-        pf.moment[std::size_t(p)].setZero();
-        pf.rolling[std::size_t(p)].setZero();
+      // Lists hold active grains only: grains are lost at rebuilds, which rebuild the lists.
+      if (dist2 >= reach * reach) {
+        // A contact that just ended clears its history and its share; most listed pairs were
+        // apart already and cost only this flag.
+        if (nl.touching[std::size_t(p)]) {
+          nl.touching[std::size_t(p)] = 0;
+          nl.history[std::size_t(p)] = ContactHistory{};
+          pf.force[std::size_t(p)].setZero();
+          pf.torque[std::size_t(p)].setZero();
+        }
         continue;
       }
+      nl.touching[std::size_t(p)] = 1;
+      ContactHistory& h = nl.history[std::size_t(p)];
       const double dist = std::sqrt(dist2);
       ContactKinematics c;
-      c.n = d / dist;
+      c.n = d * (1.0 / dist);
       c.overlap = reach - dist;
       const double rj = s.radius[j], mj = s.mass[j];
       c.r_eff = ri * rj / reach;
@@ -43,14 +58,18 @@ void pair_forces(const Model& model, State& s) {
       c.v_rel = vi - wi.cross(arm_i * c.n) - (s.v[j] + s.w[j].cross(arm_j * c.n));
       c.w_rel = wi - s.w[j];
       const ContactForce cf = Law::eval(model.params(mat_i, s.material[j]), c, dt, h);
-      pf.force[std::size_t(p)] = cf.force;
-      pf.moment[std::size_t(p)] = c.n.cross(cf.force);
-      pf.rolling[std::size_t(p)] = cf.rolling_torque;
-      pf.arm_i[std::size_t(p)] = arm_i;
-      pf.arm_j[std::size_t(p)] = arm_j;
-      max_overlap = std::max(max_overlap, c.overlap / std::min(ri, rj));
+      // Contact point at -arm_i n from i and +arm_j n from j: torques -arm n x F on both.
+      const Vec3 moment = c.n.cross(cf.force);
+      fi += cf.force;
+      ti += -arm_i * moment + cf.rolling_torque;
+      pf.force[std::size_t(p)] = -cf.force;
+      pf.torque[std::size_t(p)] = -arm_j * moment - cf.rolling_torque;
+      // Divide only when the overlap may be a new maximum.
+      if (c.overlap > max_overlap * std::min(ri, rj)) max_overlap = c.overlap / std::min(ri, rj);
       ++contacts;
     }
+    s.f[i] = fi;
+    s.torque[i] = ti;
   }
   s.counters.max_overlap_rel = max_overlap;
   s.counters.contacts = contacts;
@@ -64,12 +83,15 @@ void wall_forces(const Model& model, State& s) {
   std::int64_t contacts = 0;
   std::vector<double>& power = s.scratch_wall_power;
   power.assign(near.size(), 0.0);
+  const std::size_t walls = model.meshes.size();
+  if (s.wall_candidates.size() != near.size() * walls) s.wall_candidates.assign(near.size() * walls, WallCandidates{});
 #pragma omp parallel for schedule(dynamic, 256) reduction(max : max_overlap) reduction(+ : contacts)
   for (std::size_t q = 0; q < near.size(); ++q) {
     const std::size_t i = std::size_t(near[q]);
     if (!s.active[i]) continue;
     WallHit hits[wall_slots_per_particle];
-    const int count = wall_hits(model, s.time, s.x[i], s.radius[i], hits, wall_slots_per_particle);
+    const int count = wall_hits(model, s.time, s.x[i], s.radius[i], hits, wall_slots_per_particle,
+                                walls ? &s.wall_candidates[q * walls] : nullptr);
     WallSlot* slots = &s.wall_slots[i * wall_slots_per_particle];
     WallSlot next[wall_slots_per_particle];
     bool taken[wall_slots_per_particle] = {};
@@ -103,10 +125,12 @@ void wall_forces(const Model& model, State& s) {
       s.f[i] += cf.force;
       s.torque[i] += -arm * c.n.cross(cf.force) + cf.rolling_torque;
       power[q] += cf.force.dot(hit.wall_velocity);
-      max_overlap = std::max(max_overlap, c.overlap / s.radius[i]);
+      if (c.overlap > max_overlap * s.radius[i]) max_overlap = c.overlap / s.radius[i];
       ++contacts;
     }
-    for (int k = 0; k < wall_slots_per_particle; ++k) slots[k] = k < count ? next[k] : WallSlot{};
+    for (int k = 0; k < wall_slots_per_particle; ++k)
+      if (k < count) slots[k] = next[k];
+      else if (slots[k].wall >= 0) slots[k] = WallSlot{};
   }
   double total_power = 0;
   for (double p : power) total_power += p;  // serial: the same sum for any thread count
@@ -154,29 +178,21 @@ struct WallStage {
 void compute_pair_forces(const Model& model, State& state) { dispatch<PairStage>(model, state); }
 void compute_wall_forces(const Model& model, State& state) { dispatch<WallStage>(model, state); }
 
-void sum_forces(const Model& model, State& s) {
+void sum_forces(const Model&, State& s) {
   const NeighbourList& nl = s.neighbours;
   const PairForces& pf = s.pair_forces;
   const std::size_t n = s.size();
 #pragma omp parallel for schedule(static)
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!s.active[i]) {
-      s.f[i].setZero();
-      s.torque[i].setZero();
-      continue;
-    }
-    Vec3 f = s.mass[i] * model.gravity, t = Vec3::Zero();
-    for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p) {
-      f += pf.force[std::size_t(p)];
-      t += -pf.arm_i[std::size_t(p)] * pf.moment[std::size_t(p)] + pf.rolling[std::size_t(p)];
-    }
-    for (std::int32_t r = nl.reverse_start[i]; r < nl.reverse_start[i + 1]; ++r) {
+  for (std::size_t j = 0; j < n; ++j) {
+    if (!s.active[j]) continue;
+    Vec3 f = s.f[j], t = s.torque[j];
+    for (std::int32_t r = nl.reverse_start[j]; r < nl.reverse_start[j + 1]; ++r) {
       const std::size_t p = std::size_t(nl.reverse_pair[std::size_t(r)]);
-      f -= pf.force[p];
-      t += -pf.arm_j[p] * pf.moment[p] - pf.rolling[p];
+      f += pf.force[p];
+      t += pf.torque[p];
     }
-    s.f[i] = f;
-    s.torque[i] = t;
+    s.f[j] = f;
+    s.torque[j] = t;
   }
 }
 

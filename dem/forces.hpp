@@ -6,8 +6,10 @@
 
 namespace dem {
 
+// Gravity and the pairs' forces on their row owners into f, torque; partners' shares buffered.
 void compute_pair_forces(const Model& model, State& state);
-void sum_forces(const Model& model, State& state);  // gravity + pair buffers into f, torque
+// Adds the buffered partner shares, in a fixed order.
+void sum_forces(const Model& model, State& state);
 void compute_wall_forces(const Model& model, State& state);
 
 // Elastic energy stored in the grain-grain and grain-wall overlaps [J] (normal springs).

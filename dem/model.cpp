@@ -72,6 +72,10 @@ Model compile_model(const ModelSpec& spec, const State& state, const std::string
   m.meshes = spec.meshes;
   m.stop_overlap = spec.stop_overlap;
   for (PlaneWall& p : m.planes) p.normal.normalize();
+  for (const MeshWall& w : m.meshes) {
+    if (!w.field) throw InputError(source, "walls", "a mesh wall has no distance field", "Give the wall a mesh");
+    m.mesh_moves.push_back(w.motion.moves() || w.motion.start_position.squaredNorm() > 0);
+  }
 
   // Pairs: Hertz effective moduli; unlike materials mix e, μ and cohesion by the geometric
   // mean unless an interaction says otherwise.
@@ -89,6 +93,8 @@ Model compile_model(const ModelSpec& spec, const State& state, const std::string
       p.mu_r = std::sqrt(ma.rolling_friction * mb.rolling_friction);
       p.cohesion = std::sqrt(ma.cohesion_energy_density * mb.cohesion_energy_density);
       p.k_linear = spec.linear_stiffness;
+      p.kt_over_kn = 4.0 * p.g_star / p.e_star;
+      p.sqrt_kt_over_kn = std::sqrt(p.kt_over_kn);
       for (const Interaction& it : spec.interactions)
         if ((it.a == a && it.b == b) || (it.a == b && it.b == a)) {
           if (it.restitution) p.restitution = *it.restitution;

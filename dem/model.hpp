@@ -87,6 +87,7 @@ struct Model {
   Box3 domain;
   std::vector<PlaneWall> planes;
   std::vector<MeshWall> meshes;
+  std::vector<char> mesh_moves;  // [meshes] whether the wall's motion is not the identity
   double stop_overlap;
   std::string hash;             // of every parameter above: checkpoints carry it
 

@@ -178,13 +178,17 @@ void rebuild_neighbours(const Model& model, State& s) {
   const std::size_t pairs = std::size_t(nl.row_start[n]);
   nl.partner.resize(pairs);
   nl.history.assign(pairs, ContactHistory{});
+  nl.touching.assign(pairs, 0);
   std::size_t cursor = 0;  // into `old`, which is sorted like the new list
   for (std::size_t i = 0; i < n; ++i) {
     std::size_t p = std::size_t(nl.row_start[i]);
     for (std::int32_t j : rows[i]) {
       nl.partner[p] = j;
       while (cursor < old.size() && (old[cursor].i < std::int32_t(i) || (old[cursor].i == std::int32_t(i) && old[cursor].j < j))) ++cursor;
-      if (cursor < old.size() && old[cursor].i == std::int32_t(i) && old[cursor].j == j) nl.history[p] = old[cursor].history;
+      if (cursor < old.size() && old[cursor].i == std::int32_t(i) && old[cursor].j == j) {
+        nl.history[p] = old[cursor].history;
+        nl.touching[p] = 1;
+      }
       ++p;
     }
   }
@@ -200,11 +204,8 @@ void rebuild_neighbours(const Model& model, State& s) {
   nl.wall_shift_at_build.resize(model.meshes.size());
   for (std::size_t m = 0; m < model.meshes.size(); ++m) nl.wall_shift_at_build[m] = model.meshes[m].motion.position(s.time);
   collect_near_wall(model, s);
-  s.pair_forces.force.resize(pairs);
-  s.pair_forces.moment.resize(pairs);
-  s.pair_forces.rolling.resize(pairs);
-  s.pair_forces.arm_i.resize(pairs);
-  s.pair_forces.arm_j.resize(pairs);
+  s.pair_forces.force.assign(pairs, Vec3::Zero());
+  s.pair_forces.torque.assign(pairs, Vec3::Zero());
   ++nl.builds;
 }
 

@@ -3,6 +3,7 @@
 // list is a half list (j > i) in compressed rows, with each pair's contact history beside it
 // and per-pair force buffers, so that per-particle sums run in a fixed order whatever the
 // thread count (bit-identical results). Shapes: N particles, P listed pairs, K wall slots.
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -19,10 +20,20 @@ struct WallSlot {
   ContactHistory history;
 };
 
+// The closest triangles of the voxel cell a grain was last in, per mesh wall: a grain crosses
+// a cell every thousand steps or so, and re-reading the voxels every step cost a fifth of the
+// run time in cache misses. Derived data: it never changes a result.
+struct WallCandidates {
+  std::array<int, 3> cell{};
+  std::int32_t count = -1;  // -1: not filled yet
+  std::int32_t triangles[8];
+};
+
 struct NeighbourList {
   std::vector<std::int32_t> row_start;      // [N+1] pairs of particle i: [row_start[i], row_start[i+1])
   std::vector<std::int32_t> partner;        // [P] j > i
   std::vector<ContactHistory> history;      // [P]
+  std::vector<std::uint8_t> touching;       // [P] 1 while the pair is in contact
   std::vector<std::int32_t> reverse_start;  // [N+1] pairs where particle j is the partner
   std::vector<std::int32_t> reverse_pair;   // [P] pair indices, ascending
   std::vector<std::int32_t> near_wall;      // particles within range of a wall at build time
@@ -31,12 +42,11 @@ struct NeighbourList {
   std::int64_t builds = 0;
 };
 
-// Per-pair results of the force stage, summed per particle afterwards in a fixed order.
+// The partner's share of each pair's force, written by the row owner and summed per partner
+// afterwards in a fixed order (the owner adds its own share directly).
 struct PairForces {
-  std::vector<Vec3> force;     // [P] on i [N]
-  std::vector<Vec3> moment;    // [P] n x F_t [N]: torque on i is -a_i n x F, on j -a_j n x F
-  std::vector<Vec3> rolling;   // [P] rolling torque on i [N m]; j gets the opposite
-  std::vector<double> arm_i, arm_j;  // [P] lever arms [m]
+  std::vector<Vec3> force;   // [P] on j [N]
+  std::vector<Vec3> torque;  // [P] on j [N m]
 };
 
 struct StepCounters {
@@ -65,6 +75,7 @@ struct State {
   PairForces pair_forces;
   StepCounters counters;
   std::vector<double> scratch_wall_power;  // [near-wall grains], summed serially
+  std::vector<WallCandidates> wall_candidates;  // [near-wall grains x mesh walls], see walls.hpp
 
   double time = 0;              // [s]
   std::int64_t step = 0;

@@ -4,7 +4,8 @@
 
 namespace dem {
 
-int wall_hits(const Model& model, double time, const Vec3& x, double r, WallHit* out, int capacity) {
+int wall_hits(const Model& model, double time, const Vec3& x, double r, WallHit* out, int capacity,
+              WallCandidates* cache) {
   int count = 0;
   for (std::size_t p = 0; p < model.planes.size() && count < capacity; ++p) {
     const PlaneWall& plane = model.planes[p];
@@ -14,15 +15,24 @@ int wall_hits(const Model& model, double time, const Vec3& x, double r, WallHit*
   }
   for (std::size_t m = 0; m < model.meshes.size() && count < capacity; ++m) {
     const MeshWall& wall = model.meshes[m];
-    const Vec3 local = wall.motion.to_local(time, x);
+    const bool moving = model.mesh_moves[m];
+    const Vec3 local = moving ? wall.motion.to_local(time, x) : x;
     mesh::SurfacePoint minima[wall_slots_per_particle];
-    const int n = wall.field->local_minima(local, r, minima, wall_slots_per_particle);
-    const Quat q = wall.motion.orientation(time);
+    WallCandidates fresh;
+    WallCandidates& c = cache ? cache[m] : fresh;
+    const std::array<int, 3> cell = wall.field->cell_of(local);
+    if (c.count < 0 || c.cell[0] != cell[0] || c.cell[1] != cell[1] || c.cell[2] != cell[2]) {
+      c.cell = cell;
+      c.count = wall.field->cell_candidates(cell, c.triangles);
+    }
+    const int n = wall.field->local_minima_from(local, r, c.triangles, c.count, minima, wall_slots_per_particle);
+    const Quat q = moving ? wall.motion.orientation(time) : Quat::Identity();
     for (int k = 0; k < n && count < capacity; ++k) {
-      const Vec3 normal = q * minima[k].normal;
+      const Vec3 normal = moving ? Vec3(q * minima[k].normal) : minima[k].normal;
       const Vec3 point = x - minima[k].distance * normal;
       out[count++] = {std::int32_t(model.planes.size() + m), normal, minima[k].distance, point,
-                      wall.motion.point_velocity(time, point), wall.motion.angular_velocity};
+                      moving ? wall.motion.point_velocity(time, point) : Vec3(Vec3::Zero()),
+                      wall.motion.angular_velocity};
     }
   }
   return count;
@@ -53,6 +63,7 @@ void collect_near_wall(const Model& model, State& s) {
     }
     if (close) near.push_back(std::int32_t(i));
   }
+  s.wall_candidates.assign(near.size() * model.meshes.size(), WallCandidates{});
 }
 
 }  // namespace dem

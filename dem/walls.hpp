@@ -3,6 +3,8 @@
 // (exact local minima of the distance: both faces of a concave corner, one contact at a convex
 // edge) in the wall's own frame, moved by its prescribed motion. The wall's velocity at the
 // contact point enters damping and friction; history is kept per grain and wall contact.
+#include <array>
+
 #include "dem/model.hpp"
 #include "dem/state.hpp"
 
@@ -18,8 +20,10 @@ struct WallHit {
   Vec3 wall_angular_velocity;
 };
 
-// Every wall contact of a grain at x with radius r (at most `capacity`).
-int wall_hits(const Model& model, double time, const Vec3& x, double r, WallHit* out, int capacity);
+// Every wall contact of a grain at x with radius r (at most `capacity`). `cache`, when given,
+// holds one WallCandidates per mesh wall for this grain.
+int wall_hits(const Model& model, double time, const Vec3& x, double r, WallHit* out, int capacity,
+              WallCandidates* cache = nullptr);
 
 // At a neighbour rebuild: the grains within radius plus skin of a wall.
 void collect_near_wall(const Model& model, State& state);

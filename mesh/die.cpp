@@ -10,6 +10,7 @@
 #include "core/log.hpp"
 #include "core/sha256.hpp"
 #include "core/timer.hpp"
+#include "mesh/source_hash.hpp"
 
 namespace mesh {
 
@@ -19,8 +20,9 @@ using nlohmann::json;
 
 namespace {
 
-// Bumped whenever the mesh stage's output for the same inputs changes.
-constexpr int cache_format = 2;
+// Cache entries name the hash of the mesh module's sources (generated at build time): any
+// change to the code that builds them invalidates them.
+constexpr const char* cache_format = DIEFILL_MESH_SOURCE_HASH;
 
 json report_json(const MeshReport& r) {
   return {{"triangles", r.triangles},
@@ -105,11 +107,20 @@ void check_options(const DieOptions& o, const std::string& source) {
 WallRole parse_role(std::string_view text, std::string_view field) {
   if (text == "cavity") return WallRole::cavity;
   if (text == "tool" || text == "solid") return WallRole::tool;
+  if (text == "container") return WallRole::container;
   throw InputError("", std::string(field), "unknown role '" + std::string(text) + "'",
-                   "Use cavity (the part's shape, open at the table) or tool (the die body)");
+                   "Use cavity (the part's shape, open at the table), tool (the die body) or "
+                   "container (a closed vessel holding the grains)");
 }
 
-std::string_view role_name(WallRole role) { return role == WallRole::cavity ? "cavity" : "tool"; }
+std::string_view role_name(WallRole role) {
+  switch (role) {
+    case WallRole::cavity: return "cavity";
+    case WallRole::tool: return "tool";
+    case WallRole::container: return "container";
+  }
+  return "?";
+}
 
 DieOptions die_options_for_grains(double grain_radius_m, double skin_m, std::optional<double> voxel_m) {
   DieOptions o;
@@ -198,13 +209,18 @@ PreparedDie prepare_die(const fs::path& path, const DieOptions& options,
     ToolMesh tool = tool_from_cavity(out.cavity, table, source);
     out.solid = std::move(tool.mesh);
     out.table_z = tool.table_z;
+  } else if (options.role == WallRole::container) {
+    out.solid = out.cavity;
+    for (Triangle& t : out.solid.triangles) std::swap(t[1], t[2]);
+    out.table_z = out.after.bbox.lo.z();
   } else {
     out.solid = out.cavity;
     out.table_z = out.after.bbox.hi.z();
   }
 
   diefill::Stopwatch clock;
-  out.sdf = build_sdf(out.solid, {options.voxel_m, options.exterior_band_m, options.interior_band_m});
+  out.sdf = build_sdf(out.solid, {options.voxel_m, options.exterior_band_m, options.interior_band_m,
+                                  options.role == WallRole::container});
   diefill::log::debug("sdf: {} active voxels in {:.2f} s", out.sdf.active_voxels(), clock.seconds());
   out.sdf.set_metadata("role", std::string(role_name(options.role)));
   out.sdf.set_metadata("source_sha256", out.sha256);

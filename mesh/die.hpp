@@ -13,7 +13,10 @@
 
 namespace mesh {
 
-enum class WallRole { cavity, tool };
+// cavity: the part's shape, open at the die table (the tool is the table minus it);
+// tool: the solid itself (die body, punch, obstacle); container: a closed vessel whose inside
+// holds the grains (the LIGGGHTS benchmark's cylinder).
+enum class WallRole { cavity, tool, container };
 WallRole parse_role(std::string_view text, std::string_view field);
 std::string_view role_name(WallRole role);
 

@@ -14,6 +14,7 @@ namespace mesh {
 struct ExactSurface::Impl {
   TriMesh mesh;   // double precision copy: distances are computed from it, not from floats
   Vec3 centre;    // Embree's float buffers hold coordinates relative to it
+  bool inside_out = false;
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
 
@@ -72,6 +73,7 @@ struct ExactSurface::Impl {
 ExactSurface::ExactSurface(const TriMesh& mesh) : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.mesh = mesh;
+  s.inside_out = signed_volume(mesh) < 0;
   const Box box = bounding_box(mesh);
   s.centre = box.empty() ? Vec3::Zero() : Vec3((box.lo + box.hi) / 2);
   s.device = rtcNewDevice("threads=1");
@@ -124,7 +126,7 @@ bool ExactSurface::inside(const Vec3& p) const {
                                      Vec3(0.2213, -0.6547, 0.7229).normalized()};
   int votes = 0;
   for (const Vec3& d : directions) votes += impl_->crossings(p, d) % 2;
-  return votes >= 2;
+  return (votes >= 2) != impl_->inside_out;
 }
 
 }  // namespace mesh

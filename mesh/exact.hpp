@@ -16,7 +16,9 @@ class ExactSurface {
 
   Vec3 closest_point(const Vec3& p) const;
   double distance(const Vec3& p) const;  // unsigned [m]
-  // Ray-crossing parity, majority of three rays in skew directions; meaningful for closed meshes.
+  // Inside the solid the mesh bounds: ray-crossing parity (majority of three rays in skew
+  // directions), complemented for an inside-out mesh (negative signed volume: a container).
+  // Meaningful for closed meshes.
   bool inside(const Vec3& p) const;
   double signed_distance(const Vec3& p) const { return inside(p) ? -distance(p) : distance(p); }
 

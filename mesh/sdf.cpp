@@ -3,7 +3,9 @@
 
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
+#include <openvdb/tools/ChangeBackground.h>
 #include <openvdb/tools/MeshToVolume.h>
+#include <openvdb/tools/SignedFloodFill.h>
 #include <openvdb/tree/LeafManager.h>
 
 #include <cmath>
@@ -252,14 +254,22 @@ SdfGrid build_sdf(const TriMesh& solid, const SdfOptions& options) {
   SdfGrid out;
   out.impl_->closest = openvdb::Int32Grid::create(-1);
   out.impl_->closest->setTransform(transform);
+  // OpenVDB signs by inside/outside of the closed mesh, whatever its orientation: for an
+  // inside-out mesh its exterior is the solid side.
+  const double vdb_exterior = options.inside_out ? options.interior_band_m : options.exterior_band_m;
+  const double vdb_interior = options.inside_out ? options.exterior_band_m : options.interior_band_m;
   out.impl_->grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
-      adapter, *transform, float(options.exterior_band_m / h), float(options.interior_band_m / h),
-      flags, out.impl_->closest.get());
+      adapter, *transform, float(vdb_exterior / h), float(vdb_interior / h), flags, out.impl_->closest.get());
   out.impl_->grid->setGridClass(openvdb::GRID_LEVEL_SET);
   out.impl_->grid->setName("sdf");
   // The index grid must cover every band voxel for the candidate lookup.
   out.impl_->closest->tree().topologyUnion(out.impl_->grid->tree());
   make_band_exact(*out.impl_->grid, *out.impl_->closest, solid, out);
+  // The exact band carries the sign of the mesh's orientation; the tiles beyond it follow, at
+  // a background no smaller than either band (OpenVDB's is its exterior band).
+  openvdb::tools::signedFloodFill(out.impl_->grid->tree());
+  openvdb::tools::changeLevelSetBackground(out.impl_->grid->tree(),
+                                           float(std::max(options.exterior_band_m, options.interior_band_m)));
   return out;
 }
 

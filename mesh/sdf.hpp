@@ -16,6 +16,9 @@ struct SdfOptions {
   double voxel_m = 1e-4;          // voxel edge [m]
   double exterior_band_m = 1e-3;  // the band reaches this far outside the solid [m]
   double interior_band_m = 2e-4;  // and this far inside [m]
+  // The mesh bounds the free space (a container, triangles facing inwards): the free side is
+  // the mesh's inside, and the bands swap accordingly.
+  bool inside_out = false;
 };
 
 // Sampled values of one voxel's eight cell corners, for exact density corrections and for

@@ -73,6 +73,15 @@ struct WallField {
   // to `out` (at most `capacity`); returns how many were found. Minima on one smooth surface
   // (normals within smooth_angle_deg) count once, at the deepest.
   int local_minima(const Vec3& p, double range, SurfacePoint* out, int capacity) const;
+  // The same, from a given candidate list (the closest triangles of p's cell, see cell_of and
+  // cell_candidates): callers that step a point slowly through the grid reuse the list while
+  // the point stays in its cell, and save the voxel reads.
+  int local_minima_from(const Vec3& p, double range, const std::int32_t* candidates, int count,
+                        SurfacePoint* out, int capacity) const;
+  // Integer coordinates of the voxel cell containing p, and the distinct closest triangles of
+  // its eight corners (at most 8).
+  std::array<int, 3> cell_of(const Vec3& p) const;
+  int cell_candidates(const std::array<int, 3>& cell, std::int32_t* out) const;
   // The closest surface point found from the candidates of the voxels around p: the cell's 8
   // corners (reach 0), or the 3x3x3 voxels centred on the voxel nearest to p (reach 1, for
   // grid nodes). False beyond the band.

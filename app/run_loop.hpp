@@ -1,0 +1,37 @@
+#pragma once
+// The stepping loop every command shares: outputs at their cadence, progress, a clean stop on
+// Ctrl-C with a checkpoint, and a failed stability check turned into a checkpoint plus
+// StabilityError (exit status 3).
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "dem/model.hpp"
+#include "dem/state.hpp"
+#include "dem/step.hpp"
+
+namespace app {
+
+struct LoopOptions {
+  double until = 0;  // simulated time to reach [s]
+  std::string label = "simulating";
+  std::filesystem::path checkpoint;  // written on a stop (stability or Ctrl-C)
+  double output_every = 0;           // [s]; 0: never
+  std::function<void(const dem::State&)> output;
+  // Extra words for the progress line (grains in the cavity, ...).
+  std::function<std::string(const dem::State&)> detail;
+};
+
+struct LoopResult {
+  std::int64_t steps = 0;
+  double wall_s = 0;
+  dem::StageTimes times;
+  bool interrupted = false;  // Ctrl-C: a checkpoint was written
+};
+
+// Installs the Ctrl-C handler (once); a second Ctrl-C kills the process as usual.
+void install_interrupt_handler();
+
+LoopResult run_until(const dem::Model& model, dem::State& state, const LoopOptions& options);
+
+}  // namespace app

@@ -1,0 +1,40 @@
+#pragma once
+// The scene of `diefill simulate` (INTERFACE.md): explicit particles, materials, contact laws,
+// plane and mesh walls with motions, output settings.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/toml_reader.hpp"
+#include "dem/model.hpp"
+#include "dem/state.hpp"
+
+namespace app {
+
+struct OutputSettings {
+  std::filesystem::path directory = "out/simulation";
+  bool trajectory = false;
+  double trajectory_every = 1e-3;  // [s]
+  double snapshot_every = 0;       // [s]; 0: none
+};
+
+struct SimulationScene {
+  std::string source;
+  dem::ModelSpec spec;
+  dem::State state;
+  double duration = 1e-3;  // [s]
+  int threads = 0;         // 0: all cores
+  std::uint64_t seed = 1;
+  OutputSettings output;
+};
+
+SimulationScene load_simulation_scene(const std::filesystem::path& path, const std::vector<std::string>& overrides);
+
+// Shared by every scene kind: [contact], [[materials]], [[interactions]] into `spec`; returns
+// the material names in order.
+std::vector<std::string> read_materials_and_contact(Table& root, dem::ModelSpec& spec);
+dem::Motion read_motion(Table& motion);
+int material_index(const std::vector<std::string>& names, const std::string& name, Table& where, const std::string& key);
+
+}  // namespace app

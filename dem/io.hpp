@@ -1,0 +1,35 @@
+#pragma once
+// Particle files (INTERFACE.md): particles CSV in and out, trajectory CSV, VTU snapshots that
+// ParaView reads. SI units throughout.
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "dem/state.hpp"
+
+namespace dem {
+
+// Reads `id,x,y,z,vx,vy,vz,wx,wy,wz,radius[,density]` (header required, columns in any order;
+// body,qw,qx,qy,qz are accepted and ignored for spheres). Grains get `material`, and
+// `default_density` when the file has no density column. Throws InputError naming the file,
+// the line and the column for missing columns, unparsable or non-finite values.
+State read_particles_csv(const std::filesystem::path& path, int material, double default_density);
+void write_particles_csv(const State& state, const std::filesystem::path& path);
+
+// Appends `t,id,x,y,z,vx,vy,vz,wx,wy,wz,fx,fy,fz` rows.
+class TrajectoryWriter {
+ public:
+  explicit TrajectoryWriter(const std::filesystem::path& path);
+  ~TrajectoryWriter();
+  void write(const State& state);
+
+ private:
+  std::FILE* file_ = nullptr;
+};
+
+// VTK XML unstructured grid of points with point data id, radius, velocity, angular_velocity,
+// force, body.
+void write_vtu(const State& state, const std::filesystem::path& path);
+
+}  // namespace dem
