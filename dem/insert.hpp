@@ -13,7 +13,8 @@ namespace dem {
 
 struct InsertRegion {
   Box3 box;  // candidate centres are drawn here
-  // When set, a centre is kept only if the sphere lies inside this solid (distance <= -r).
+  // When set, a centre is kept only if the sphere lies inside this solid (distance <= -r; the
+  // field's solid-side band must reach the largest radius, or no grain deeper than it fits).
   std::shared_ptr<const mesh::WallField> inside;
   // ... and outside every wall of the model (distance >= r) when this is given.
   const Model* clear_of_walls = nullptr;

@@ -8,6 +8,8 @@
 #include <openvdb/tools/SignedFloodFill.h>
 #include <openvdb/tree/LeafManager.h>
 
+#include <fmt/core.h>
+
 #include <cmath>
 #include <mutex>
 
@@ -125,7 +127,14 @@ WallField SdfGrid::wall_field(const TriMesh& solid) const {
   WallField w;
   w.set_surface(solid);
   w.voxel = voxel_size();
-  w.background = float(background());
+  auto band = [&](const char* key) {
+    auto it = impl_->metadata.find(key);
+    return it != impl_->metadata.end() ? float(std::stod(it->second)) : float(background());
+  };
+  w.free_band = band("exterior_band_m");
+  w.solid_band = band("interior_band_m");
+  // Voxels of a leaf outside the band hold the background: clamp them to the side's band.
+  const float free_band = w.free_band, solid_band = w.solid_band;
   const auto& tree = impl_->grid->tree();
   const openvdb::CoordBBox box = impl_->grid->evalActiveVoxelBoundingBox();
   for (int d = 0; d < 3; ++d) {
@@ -159,7 +168,8 @@ WallField SdfGrid::wall_field(const TriMesh& solid) const {
     w.brick_of_cell[cell_of(leaf->origin())] = brick;
     const auto* index_leaf = closest_acc.probeConstLeaf(leaf->origin());
     for (openvdb::Index n = 0; n < 512; ++n) {
-      w.distance.push_back(leaf->getValue(n));
+      const float v = leaf->getValue(n);
+      w.distance.push_back(leaf->isValueOn(n) ? v : (v < 0 ? -solid_band : free_band));
       const bool band = leaf->isValueOn(n) && index_leaf && index_leaf->isValueOn(n);
       w.closest.push_back(band ? index_leaf->getValue(n) : -1);
     }
@@ -262,6 +272,8 @@ SdfGrid build_sdf(const TriMesh& solid, const SdfOptions& options) {
       adapter, *transform, float(vdb_exterior / h), float(vdb_interior / h), flags, out.impl_->closest.get());
   out.impl_->grid->setGridClass(openvdb::GRID_LEVEL_SET);
   out.impl_->grid->setName("sdf");
+  out.impl_->metadata["exterior_band_m"] = fmt::format("{:.17g}", options.exterior_band_m);
+  out.impl_->metadata["interior_band_m"] = fmt::format("{:.17g}", options.interior_band_m);
   // The index grid must cover every band voxel for the candidate lookup.
   out.impl_->closest->tree().topologyUnion(out.impl_->grid->tree());
   make_band_exact(*out.impl_->grid, *out.impl_->closest, solid, out);

@@ -37,7 +37,7 @@ class SdfGrid {
   SdfGrid& operator=(SdfGrid&&) noexcept;
 
   double voxel_size() const;          // [m]
-  double background() const;          // |distance| reported beyond the band [m]
+  double background() const;          // |distance| OpenVDB reports beyond the band [m]
   std::size_t active_voxels() const;
   std::size_t memory_bytes() const;
   Box active_bounds() const;          // world bounds of the active voxels [m]

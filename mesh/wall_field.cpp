@@ -76,14 +76,14 @@ bool WallField::voxel_at(int i, int j, int k, float& value, std::int32_t& triang
   triangle = -1;
   if (bi < 0 || bj < 0 || bk < 0 || bi >= brick_count[0] || bj >= brick_count[1] ||
       bk >= brick_count[2]) {
-    value = background;
+    value = free_band;
     return false;
   }
   const std::int32_t brick =
       brick_of_cell[(std::size_t(bi) * std::size_t(brick_count[1]) + std::size_t(bj)) *
                         std::size_t(brick_count[2]) + std::size_t(bk)];
   if (brick < 0) {
-    value = brick == -2 ? -background : background;
+    value = brick == -2 ? -solid_band : free_band;
     return false;
   }
   const std::size_t n = std::size_t(brick) * 512 + std::size_t(((i & 7) * 8 + (j & 7)) * 8 + (k & 7));

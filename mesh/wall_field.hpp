@@ -54,7 +54,10 @@ struct WallField {
 
   // Sparse voxels: bricks of 8x8x8 voxels; voxel (i, j, k) sits at (i, j, k) * voxel.
   double voxel = 0.0;                    // [m]
-  float background = 0.0f;               // |distance| reported beyond the band [m]
+  // Beyond the band the distance is known only to exceed the band's width on that side: the
+  // free side reports +free_band, the solid side -solid_band (lower bounds of |distance|).
+  float free_band = 0.0f;                // [m]
+  float solid_band = 0.0f;               // [m]
   std::array<int, 3> brick_min{}, brick_count{};  // dense brick index box, in bricks
   std::vector<std::int32_t> brick_of_cell;  // >= 0: brick; -1: no brick, outside; -2: inside
   std::vector<float> distance;           // 512 per brick [m]
@@ -64,7 +67,7 @@ struct WallField {
 
   // True when all eight voxels around p are in the band.
   bool band_cell(const Vec3& p) const;
-  // Trilinear signed distance [m] (± background beyond the band).
+  // Trilinear signed distance [m] (+free_band or -solid_band beyond the band).
   double trilinear(const Vec3& p) const;
   // Exact signed distance to the surface near p (within the band), from the local minima;
   // falls back to trilinear() beyond the band.

@@ -2,6 +2,8 @@
 // status 2 (run under AddressSanitizer and UBSan by scripts/test.sh).
 #include <gtest/gtest.h>
 
+#include <fmt/core.h>
+
 #include "mesh/import.hpp"
 #include "mesh/shapes.hpp"
 #include "meshes.hpp"
@@ -86,4 +88,59 @@ TEST(Cli, FailedSdfKeepsTheEarlierOutput) {
   test::write_text(dir / "disc.stl", "garbage");
   EXPECT_EQ(test::run_diefill("sdf " + (dir / "disc.stl").string() + " -o " + out).status, 2);
   EXPECT_EQ(test::read_text(out), before);
+}
+
+namespace {
+// A small scene: 200 grains above a floor, written into `dir`.
+void write_scene(const test::TempDir& dir, const std::string& extra_simulation = "") {
+  std::string csv = "id,x,y,z,vx,vy,vz,wx,wy,wz,radius\n";
+  for (int n = 0; n < 200; ++n)
+    csv += fmt::format("{},{},{},{},0,0,-0.1,0,0,0,5e-4\n", n, (n % 10) * 1.1e-3, (n / 10 % 5) * 1.1e-3,
+                       (n / 50) * 1.1e-3 + 1e-3);
+  test::write_text(dir / "particles.csv", csv);
+  test::write_text(dir / "scene.toml", "[simulation]\nduration = 0.01\n" + extra_simulation +
+                                           "\n[[materials]]\nname = \"glass\"\nyoungs_modulus = 5e6\n"
+                                           "\n[particles]\nfile = \"particles.csv\"\n"
+                                           "\n[[walls]]\ntype = \"plane\"\nnormal = [0.0, 0.0, 1.0]\n"
+                                           "\n[output]\ntrajectory = true\ntrajectory_every = 0.005\nsnapshot_every = 0.005\n");
+}
+}  // namespace
+
+TEST(CliSimulate, WritesTheFilesOfTheInterface) {
+  test::TempDir dir;
+  write_scene(dir);
+  const test::Run run = test::run_diefill("simulate " + (dir / "scene.toml").string() + " --out " + (dir / "out").string());
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_EQ(test::read_text(dir / "out" / "particles.csv").rfind("id,x,y,z,vx,vy,vz,wx,wy,wz,radius,density\n", 0), 0u);
+  EXPECT_EQ(test::read_text(dir / "out" / "trajectory.csv").rfind("t,id,x,y,z,vx,vy,vz,wx,wy,wz,fx,fy,fz\n", 0), 0u);
+  const std::string vtu = test::read_text(dir / "out" / "snapshot_00000.vtu");
+  for (const char* array : {"\"id\"", "\"radius\"", "\"velocity\"", "\"angular_velocity\"", "\"force\"", "\"body\""})
+    EXPECT_NE(vtu.find(array), std::string::npos) << array;
+  EXPECT_NE(test::read_text(dir / "out" / "summary.json").find("particle_steps_per_s"), std::string::npos);
+}
+
+TEST(CliSimulate, UnknownKeysAndBadValuesNameFileAndLine) {
+  test::TempDir dir;
+  write_scene(dir, "duratoin = 2.0");
+  const test::Run typo = test::run_diefill("simulate " + (dir / "scene.toml").string());
+  EXPECT_EQ(typo.status, 2) << typo.output;
+  EXPECT_NE(typo.output.find("scene.toml:3: simulation.duratoin: unknown key"), std::string::npos) << typo.output;
+  write_scene(dir, "gravity = \"down\"");
+  const test::Run type = test::run_diefill("simulate " + (dir / "scene.toml").string());
+  EXPECT_EQ(type.status, 2);
+  EXPECT_NE(type.output.find("simulation.gravity: must be an array of three numbers"), std::string::npos) << type.output;
+  write_scene(dir);
+  test::write_text(dir / "particles.csv", "id,x,y,z,vx,vy,vz,wx,wy,wz\n0,0,0,0,0,0,0,0,0,0\n");
+  const test::Run columns = test::run_diefill("simulate " + (dir / "scene.toml").string());
+  EXPECT_EQ(columns.status, 2);
+  EXPECT_NE(columns.output.find("column radius: is missing"), std::string::npos) << columns.output;
+}
+
+TEST(CliSimulate, UnstableStepStopsWithStatus3AndACheckpoint) {
+  test::TempDir dir;
+  write_scene(dir, "time_step = 2e-4");
+  const test::Run run = test::run_diefill("simulate " + (dir / "scene.toml").string() + " --out " + (dir / "out").string());
+  EXPECT_EQ(run.status, 3) << run.output;
+  EXPECT_NE(run.output.find("time step"), std::string::npos) << run.output;
+  EXPECT_TRUE(std::filesystem::exists(dir / "out" / "checkpoint.bin"));
 }

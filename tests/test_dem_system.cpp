@@ -8,6 +8,8 @@
 #include "dem/insert.hpp"
 #include "dem_support.hpp"
 #include "dem/forces.hpp"
+#include "mesh/exact.hpp"
+#include "mesh/shapes.hpp"
 #include "support.hpp"
 
 using dem::Vec3;
@@ -138,4 +140,35 @@ TEST(Reproducibility, ResumedRunMatchesTheUninterruptedOne) {
   dem::ModelSpec other = spec;
   other.materials[0].sliding_friction = 0.5;
   EXPECT_THROW(dem::read_checkpoint(dem::compile_model(other, b, "gas"), dir / "run.ckpt"), diefill::InputError);
+}
+
+TEST(Insertion, FillsAClosedMeshWithoutOverlapsReproducibly) {
+  const mesh::TriMesh ring = mesh::bundled_die("ring");
+  mesh::SdfOptions o;
+  o.voxel_m = 0.1e-3;
+  o.exterior_band_m = 0.2e-3;
+  o.interior_band_m = 0.5e-3;  // reaches the largest radius, 0.39 mm
+  const auto field = std::make_shared<const mesh::WallField>(mesh::build_sdf(ring, o).wall_field(ring));
+  auto fill = [&](std::uint64_t seed) {
+    dem::State s;
+    dem::InsertRegion region;
+    region.box = {Vec3(-10e-3, -10e-3, -10e-3), Vec3(10e-3, 10e-3, 0)};
+    region.inside = field;
+    dem::InsertRequest req;
+    req.count = 2000;
+    req.radius = 0.3e-3;
+    req.radius_spread = 0.3;
+    req.seed = seed;
+    EXPECT_EQ(dem::insert_spheres(s, region, req), 2000u);
+    return s;
+  };
+  const dem::State a = fill(5), b = fill(5), c = fill(6);
+  const mesh::ExactSurface exact(ring);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_LE(exact.signed_distance(a.x[i]), -a.radius[i] + 1e-12) << "inside the ring, clear of its walls";
+    for (std::size_t j = i + 1; j < a.size(); ++j)
+      ASSERT_GE((a.x[i] - a.x[j]).norm(), a.radius[i] + a.radius[j]) << i << " overlaps " << j;
+  }
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_NE(a.x, c.x);
 }

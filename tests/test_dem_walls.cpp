@@ -177,3 +177,25 @@ TEST_P(PourIntoDie, TenThousandGrainsSettleWithoutLeaking) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Dies, PourIntoDie, ::testing::Values("ring", "disc"));
+
+TEST(MeshWall, PlateThinnerThanAVoxelStillBlocks) {
+  // A plate a quarter voxel thick, hit head-on at 1 m/s from above and from below.
+  const double r = 0.5e-3, voxel = r / 4;
+  const mesh::TriMesh plate = mesh::box_solid(Vec3(-5e-3, -5e-3, -0.125 * voxel), Vec3(5e-3, 5e-3, 0.125 * voxel));
+  for (double side : {1.0, -1.0}) {
+    dem::ModelSpec spec = test::spec_with({test::glass(0.5), test::rigid_wall(0.5)});
+    spec.meshes.push_back({test::wall_field_of(plate, voxel), 1, {}, "plate"});
+    spec.max_impact_speed = 1.0;
+    dem::State s;
+    s.add_sphere(0, Vec3(0.3e-3, 0.2e-3, side * (r + 0.2e-3)), r, 2500, 0, Vec3(0, 0, -side * 1.0));
+    const dem::Model model = dem::compile_model(spec, s, "plate");
+    dem::initialize(model, s);
+    double closest = 1;
+    for (int n = 0; n < int(2e-3 / model.dt); ++n) {
+      dem::step(model, s);
+      closest = std::min(closest, side * s.x[0].z());
+    }
+    EXPECT_GT(closest, 0.9 * r) << "the grain stays on its side";
+    EXPECT_GT(side * s.v[0].z(), 0.4) << "and bounces back";
+  }
+}
