@@ -54,6 +54,19 @@ struct BenchCommand {
 };
 int run_bench(const BenchCommand& command);
 
+struct DensityCommand {
+  std::filesystem::path particles;  // CSV or VTU
+  std::filesystem::path die;
+  std::filesystem::path output;
+  std::string units = "mm";
+  std::string role = "cavity";
+  double voxel_mm = 0;        // 0: four grain radii
+  std::string method = "exact";
+  double width_mm = 0;        // Gaussian width (0: one voxel)
+  double material_density = 0;  // 0: from the particle file
+};
+int run_density(const DensityCommand& command);
+
 struct DieCommand {
   std::string name;  // bundled die
   std::filesystem::path output;

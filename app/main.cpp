@@ -56,6 +56,20 @@ void add_bench(CLI::App& root, app::BenchCommand& c, std::function<int()>& actio
   cmd->callback([&] { action = [&] { return app::run_bench(c); }; });
 }
 
+void add_density(CLI::App& root, app::DensityCommand& c, std::function<int()>& action) {
+  CLI::App* cmd = root.add_subcommand("density", "Density field of a particle file on a die");
+  cmd->add_option("PARTICLES", c.particles, "Particles CSV or VTU snapshot")->required();
+  cmd->add_option("--die", c.die, "The die's cavity mesh")->required();
+  cmd->add_option("-o,--output", c.output, "Output folder")->required();
+  cmd->add_option("--units", c.units, "Length unit of the die mesh")->capture_default_str();
+  cmd->add_option("--role", c.role, "cavity or container")->capture_default_str();
+  cmd->add_option("--voxel", c.voxel_mm, "Voxel edge [mm] (default: four grain radii)");
+  cmd->add_option("--method", c.method, "exact (volume split exactly) or gaussian (kernel)")->capture_default_str();
+  cmd->add_option("--width", c.width_mm, "Gaussian width [mm] (default: one voxel)");
+  cmd->add_option("--material-density", c.material_density, "Grain material density [kg/m³] (default: from the file)");
+  cmd->callback([&] { action = [&] { return app::run_density(c); }; });
+}
+
 void add_die(CLI::App& root, app::DieCommand& c, std::function<int()>& action) {
   CLI::App* cmd = root.add_subcommand("die", "Write a bundled die mesh (ring, disc) as binary STL in mm");
   cmd->add_option("NAME", c.name, "ring or disc")->required();
@@ -83,6 +97,8 @@ int main(int argc, char** argv) {
   add_simulate(root, simulate, action);
   app::BenchCommand bench;
   add_bench(root, bench, action);
+  app::DensityCommand density;
+  add_density(root, density, action);
   add_sdf(root, sdf, action);
   add_die(root, die, action);
   try {

@@ -59,4 +59,30 @@ void PendingFile::commit() {
   committed_ = true;
 }
 
+StagingFolder::StagingFolder(fs::path target) : target_(std::move(target)) {
+  staging_ = target_ / (".staging-" + std::to_string(::getpid()));
+  std::error_code ec;
+  fs::remove_all(staging_, ec);
+  fs::create_directories(staging_, ec);
+  if (ec)
+    throw InputError(target_.string(), "", "cannot create the output folder (" + ec.message() + ")",
+                     "Choose an output folder you can write to");
+}
+
+StagingFolder::~StagingFolder() {
+  std::error_code ec;
+  fs::remove_all(staging_, ec);
+}
+
+void StagingFolder::commit() {
+  for (const auto& entry : fs::directory_iterator(staging_)) {
+    std::error_code ec;
+    fs::rename(entry.path(), target_ / entry.path().filename(), ec);
+    if (ec)
+      throw InputError((target_ / entry.path().filename()).string(), "", "cannot be written (" + ec.message() + ")",
+                       "Check that the output folder is writable");
+  }
+  committed_ = true;
+}
+
 }  // namespace diefill

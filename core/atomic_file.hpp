@@ -28,4 +28,22 @@ class PendingFile {
   bool committed_ = false;
 };
 
+// A folder of outputs that appear together or not at all: files are written into a hidden
+// staging folder inside `target`, and commit() moves them into `target` (replacing earlier
+// versions); destroyed without commit, the staging folder is removed and `target` is as before.
+class StagingFolder {
+ public:
+  explicit StagingFolder(std::filesystem::path target);
+  ~StagingFolder();
+  StagingFolder(const StagingFolder&) = delete;
+  StagingFolder& operator=(const StagingFolder&) = delete;
+  std::filesystem::path operator/(const std::string& name) const { return staging_ / name; }
+  const std::filesystem::path& path() const { return staging_; }
+  void commit();
+
+ private:
+  std::filesystem::path target_, staging_;
+  bool committed_ = false;
+};
+
 }  // namespace diefill

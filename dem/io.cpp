@@ -67,14 +67,19 @@ State read_particles_csv(const fs::path& path, int material, double default_dens
                          fmt::format("'{}' is not a finite number", cells[c]), "Correct the value");
       return v;
     };
+    const double id = value("id");
+    const Vec3 x(value("x"), value("y"), value("z")), v(value("vx"), value("vy"), value("vz")),
+        w(value("wx"), value("wy"), value("wz"));
     const double radius = value("radius");
     if (!(radius > 0))
       throw InputError(path.string(), fmt::format("line {}, column radius", number), "must be positive", "Correct the value");
     const double density = has_density ? value("density") : default_density;
-    if (!(density > 0))
+    if (has_density && !(density > 0))
       throw InputError(path.string(), fmt::format("line {}, column density", number), "must be positive", "Correct the value");
-    s.add_sphere(std::int64_t(value("id")), Vec3(value("x"), value("y"), value("z")), radius, density, material,
-                 Vec3(value("vx"), value("vy"), value("vz")), Vec3(value("wx"), value("wy"), value("wz")));
+    if (!has_density && !(density > 0))
+      throw InputError(path.string(), "column density", "is missing and no material density is given",
+                       "Add a density column, or name the material (scene) or pass --material-density");
+    s.add_sphere(std::int64_t(id), x, radius, density, material, v, w);
   }
   if (s.size() == 0) throw InputError(path.string(), "", "holds no particles", "Add rows below the header");
   return s;
@@ -139,6 +144,41 @@ void write_vtu(const State& s, const fs::path& path) {
   for (std::size_t i = 0; i < s.size(); ++i) out += "1\n";  // VTK_VERTEX
   out += "</DataArray>\n</Cells>\n</Piece></UnstructuredGrid>\n</VTKFile>\n";
   diefill::write_file_atomic(path, out);
+}
+
+}  // namespace dem
+
+namespace dem {
+
+State read_particles_vtu(const fs::path& path, int material, double density) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path.string(), "", "cannot be read", "Check the path");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto array = [&](const std::string& name) {
+    const std::size_t at = text.find("Name=\"" + name + "\"");
+    if (at == std::string::npos)
+      throw InputError(path.string(), "DataArray " + name, "is missing", "Give a VTU snapshot diefill wrote");
+    const std::size_t begin = text.find('>', at) + 1, end = text.find("</DataArray>", begin);
+    std::vector<double> values;
+    std::istringstream numbers(text.substr(begin, end - begin));
+    for (double v; numbers >> v;) {
+      if (!std::isfinite(v)) throw InputError(path.string(), "DataArray " + name, "holds a non-finite value", "Correct the file");
+      values.push_back(v);
+    }
+    return values;
+  };
+  const std::vector<double> points = array("Points"), radius = array("radius"), ids = array("id");
+  if (points.size() != 3 * radius.size() || ids.size() != radius.size() || radius.empty())
+    throw InputError(path.string(), "DataArray", "the arrays do not match in length", "Give a VTU snapshot diefill wrote");
+  State s;
+  for (std::size_t i = 0; i < radius.size(); ++i)
+    s.add_sphere(std::int64_t(ids[i]), Vec3(points[3 * i], points[3 * i + 1], points[3 * i + 2]), radius[i], density, material);
+  return s;
+}
+
+State read_particles(const fs::path& path, int material, double default_density) {
+  if (path.extension() == ".vtu") return read_particles_vtu(path, material, default_density);
+  return read_particles_csv(path, material, default_density);
 }
 
 }  // namespace dem

@@ -33,3 +33,10 @@ class TrajectoryWriter {
 void write_vtu(const State& state, const std::filesystem::path& path);
 
 }  // namespace dem
+
+namespace dem {
+// Reads a VTU snapshot written by write_vtu (points and the radius array; the rest ignored).
+State read_particles_vtu(const std::filesystem::path& path, int material, double density);
+// By extension: .csv or .vtu.
+State read_particles(const std::filesystem::path& path, int material, double default_density);
+}  // namespace dem

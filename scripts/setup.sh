@@ -23,6 +23,7 @@ packages=(
   libboost-iostreams-dev                    # OpenVDB needs it; its package does not pull it in
   libtomlplusplus-dev nlohmann-json3-dev libfmt-dev libcli11-dev zlib1g-dev
   python3-openvdb python3-numpy libopenvdb-tools   # an independent reader for the .vdb tests
+  python3-matplotlib                        # the pictures of reports and studies
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -4,6 +4,9 @@
 
 #include <fmt/core.h>
 
+#include <cmath>
+#include <nlohmann/json.hpp>
+
 #include "mesh/import.hpp"
 #include "mesh/shapes.hpp"
 #include "meshes.hpp"
@@ -143,4 +146,87 @@ TEST(CliSimulate, UnstableStepStopsWithStatus3AndACheckpoint) {
   EXPECT_EQ(run.status, 3) << run.output;
   EXPECT_NE(run.output.find("time step"), std::string::npos) << run.output;
   EXPECT_TRUE(std::filesystem::exists(dir / "out" / "checkpoint.bin"));
+}
+
+namespace {
+// Grains resting in the disc cavity (a loose random fill), as a particles CSV.
+void write_disc_particles(const std::filesystem::path& path) {
+  std::string csv = "id,x,y,z,vx,vy,vz,wx,wy,wz,radius,density\n";
+  int id = 0;
+  for (int i = -8; i <= 8; ++i)
+    for (int j = -8; j <= 8; ++j)
+      for (int k = 0; k < 8; ++k) {
+        const double x = i * 1.05e-3, y = j * 1.05e-3, z = -9.4e-3 + k * 1.05e-3;
+        if (std::hypot(x, y) < 9.4e-3) csv += fmt::format("{},{},{},{},0,0,0,0,0,0,5e-4,7800\n", id++, x, y, z);
+      }
+  test::write_text(path, csv);
+}
+}  // namespace
+
+TEST(CliDensity, WritesAFieldThatOpenVdbReadsBack) {
+  test::TempDir dir;
+  write_disc_particles(dir / "grains.csv");
+  const std::string out = (dir / "field").string();
+  const test::Run run = test::run_diefill("density " + (dir / "grains.csv").string() + " --die " +
+                                          (test::source_dir() / "dies" / "disc.stl").string() + " --voxel 1 -o " + out);
+  ASSERT_EQ(run.status, 0) << run.output;
+  for (const char* file : {"density.vdb", "density.vti", "density.json", "top_view.png", "section.png", "histogram.png"})
+    EXPECT_TRUE(std::filesystem::exists(dir / "field" / file)) << file;
+  // An independent reader: OpenVDB's Python module recomputes the cavity-weighted mean.
+  test::write_text(dir / "check.py", R"(
+import json, sys
+import pyopenvdb as vdb
+grids, meta = vdb.readAll(sys.argv[1] + "/density.vdb")
+names = sorted(g.name for g in grids)
+g = {x.name: x for x in grids}
+phi, cav, rho = g["solid_fraction"], g["cavity_fraction"], g["density"]
+acc_phi, acc_rho = phi.getConstAccessor(), rho.getConstAccessor()
+num = den = worst = 0.0
+for item in cav.citerOnValues():
+    ijk = item.min
+    w = item.value
+    num += w * acc_phi.getValue(ijk)
+    den += w
+    worst = max(worst, abs(acc_rho.getValue(ijk) - 7800 * acc_phi.getValue(ijk)))
+report = json.load(open(sys.argv[1] + "/density.json"))
+print(json.dumps({"names": names, "voxel": phi.transform.voxelSize()[0], "units": phi["units"],
+                  "sha": phi["die_sha256"], "grains": phi["grains"], "material_density": phi["material_density"],
+                  "mean": num / den, "report_mean": report["fill"]["solid_fraction_mean"], "density_error": worst,
+                  "origin": list(phi.transform.indexToWorld((0, 0, 0)))}))
+)");
+  const std::string python = "/usr/bin/python3 " + (dir / "check.py").string() + " " + out + " 2>&1";
+  FILE* pipe = ::popen(python.c_str(), "r");
+  std::string text;
+  char buffer[4096];
+  while (std::size_t n = std::fread(buffer, 1, sizeof buffer, pipe)) text.append(buffer, n);
+  ASSERT_EQ(::pclose(pipe), 0) << text;
+  const auto j = nlohmann::json::parse(text);
+  EXPECT_EQ(j["names"], nlohmann::json({"cavity_fraction", "density", "solid_fraction"}));
+  EXPECT_DOUBLE_EQ(j["voxel"].get<double>(), 1e-3);
+  EXPECT_EQ(j["units"], "m");
+  EXPECT_EQ(j["sha"].get<std::string>().size(), 64u);
+  EXPECT_DOUBLE_EQ(j["material_density"].get<double>(), 7800);
+  EXPECT_NEAR(j["mean"].get<double>(), j["report_mean"].get<double>(), 1e-6);
+  EXPECT_LT(j["density_error"].get<double>(), 1e-2);
+  // vdb_print, Debian's command-line reader, lists the three grids.
+  FILE* p2 = ::popen(("vdb_print " + out + "/density.vdb 2>&1").c_str(), "r");
+  std::string printed;
+  while (std::size_t n = std::fread(buffer, 1, sizeof buffer, p2)) printed.append(buffer, n);
+  ::pclose(p2);
+  for (const char* grid : {"solid_fraction", "density", "cavity_fraction"}) EXPECT_NE(printed.find(grid), std::string::npos) << printed;
+}
+
+TEST(CliDensity, BadInputLeavesNoPartialOutput) {
+  test::TempDir dir;
+  const std::string die = " --die " + (test::source_dir() / "dies" / "disc.stl").string();
+  auto expect_refused = [&](const std::string& csv, const std::string& words, const std::string& die_args) {
+    test::write_text(dir / "grains.csv", csv);
+    const test::Run run = test::run_diefill("density " + (dir / "grains.csv").string() + die_args + " -o " + (dir / "out").string());
+    EXPECT_EQ(run.status, 2) << run.output;
+    EXPECT_NE(run.output.find(words), std::string::npos) << run.output;
+    EXPECT_TRUE(!std::filesystem::exists(dir / "out") || std::filesystem::is_empty(dir / "out")) << "partial output";
+  };
+  expect_refused("id,x,y,z,vx,vy,vz,wx,wy,wz\n1,0,0,-0.005,0,0,0,0,0,0\n", "column radius", die);
+  expect_refused("id,x,y,z,vx,vy,vz,wx,wy,wz,radius\n1,nan,0,-0.005,0,0,0,0,0,0,5e-4\n", "not a finite number", die);
+  expect_refused("id,x,y,z,vx,vy,vz,wx,wy,wz,radius,density\n1,0.5,0.5,0.5,0,0,0,0,0,0,5e-4,7800\n", "lies in the cavity", die);
 }

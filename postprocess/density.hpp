@@ -1,0 +1,68 @@
+#pragma once
+// Density fields on the die geometry (module `post`). Grain volume is split exactly among the
+// voxels it overlaps; each voxel's solid volume is divided by the part of the voxel inside the
+// cavity, so that voxels cut by the wall are not biased low; voxels with too little cavity to
+// carry a value are merged with their fullest neighbour and flagged.
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace post {
+
+using Vec3 = Eigen::Vector3d;
+
+struct Grain {
+  Vec3 centre;        // [m]
+  double radius;      // [m]
+  double weight = 1;  // volume multiplier: a clump member's share of its grain's true volume
+};
+
+// A regular grid of voxels; voxel (i, j, k) spans origin + h [i, i+1) x [j, j+1) x [k, k+1).
+struct VoxelGrid {
+  Vec3 origin = Vec3::Zero();  // [m] corner of voxel (0, 0, 0)
+  double voxel = 1e-3;         // [m]
+  int nx = 0, ny = 0, nz = 0;
+
+  std::size_t size() const { return std::size_t(nx) * std::size_t(ny) * std::size_t(nz); }
+  std::size_t index(int i, int j, int k) const {
+    return (std::size_t(i) * std::size_t(ny) + std::size_t(j)) * std::size_t(nz) + std::size_t(k);
+  }
+  Vec3 centre(int i, int j, int k) const { return origin + voxel * Vec3(i + 0.5, j + 0.5, k + 0.5); }
+  double voxel_volume() const { return voxel * voxel * voxel; }
+};
+
+// The grid covering [lo, hi] with voxels of edge h, aligned so that `anchor` (the die table's
+// height, say) lies on a voxel face.
+VoxelGrid grid_covering(const Vec3& lo, const Vec3& hi, double h, double anchor_z);
+
+// Adds each grain's volume inside each voxel [m³] (exact sphere-box intersections); the part of
+// a grain outside the grid is not counted.
+void bin_exact(const std::vector<Grain>& grains, const VoxelGrid& grid, std::vector<double>& solid);
+
+// Gaussian coarse graining (after MercuryCG): each grain's volume spread with a normalised
+// Gaussian of standard deviation `width`, cut at 3 widths and renormalised on the grid nodes.
+void bin_gaussian(const std::vector<Grain>& grains, const VoxelGrid& grid, double width, std::vector<double>& solid);
+// The cavity fractions smoothed by the same kernel: the denominator of the kernel method.
+std::vector<double> smooth_gaussian(const VoxelGrid& grid, const std::vector<double>& field, double width);
+
+// Fraction of each voxel inside the cavity, from the signed distance into it (positive inside;
+// beyond a known range a lower bound of the magnitude is enough). A cube farther from the wall
+// than its half-diagonal is wholly in or out; a cut cube is split in eight, down to `depth`
+// levels, where a cube of side a takes clamp(1/2 + d/a, 0, 1) (exact for a face-parallel wall).
+std::vector<double> cavity_fractions(const VoxelGrid& grid, const std::function<double(const Vec3&)>& distance_into_cavity,
+                                     int depth);
+
+struct CorrectedField {
+  std::vector<double> solid_fraction;  // solid volume over cavity volume, NaN outside the cavity
+  std::vector<std::uint8_t> merged;    // 1 where the voxel's value comes from a merge
+  std::size_t merged_count = 0;
+};
+
+// Wall correction: solid / (cavity fraction * voxel volume). Voxels whose cavity fraction is
+// below `min_cavity` are merged with the 6-neighbour of largest cavity fraction (their solid
+// and cavity volumes pooled), never divided by nearly nothing.
+CorrectedField correct_for_walls(const VoxelGrid& grid, const std::vector<double>& solid,
+                                 const std::vector<double>& cavity, double min_cavity);
+
+}  // namespace post

@@ -1,1 +1,0 @@
-// Density fields arrive with issue 4.

@@ -1,0 +1,84 @@
+#!/usr/bin/python3
+"""Pictures of a fill density field, from the plot_data.json diefill writes beside it.
+
+    plots.py OUT_DIR   ->  OUT_DIR/top_view.png, section.png, histogram.png, profiles.png
+
+Each picture has axes with units and, where colour carries a value, a colour bar.
+"""
+import json
+import sys
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def main(out_dir: Path) -> None:
+    data = json.loads((out_dir / "plot_data.json").read_text())
+    h_mm = data["voxel_m"] * 1e3
+    ox, oy, oz = (c * 1e3 for c in data["origin_m"])
+    nx, ny, nz = data["shape"]
+    extent_xy = [ox, ox + nx * h_mm, oy, oy + ny * h_mm]
+
+    top = np.array(data["top_view"], dtype=float).T
+    cavity = np.array(data["top_cavity_voxels"], dtype=float).T
+    top = np.ma.masked_less(top, 0)
+    values = np.array(data["histogram_values"], dtype=float)
+    lo, hi = (np.percentile(values, 1), np.percentile(values, 99)) if values.size else (0, 1)
+
+    fig, ax = plt.subplots(figsize=(6, 5))
+    im = ax.imshow(top, origin="lower", extent=extent_xy, cmap="viridis", vmin=lo, vmax=hi, interpolation="nearest")
+    ax.contour(np.linspace(ox + h_mm / 2, ox + (nx - 0.5) * h_mm, nx), np.linspace(oy + h_mm / 2, oy + (ny - 0.5) * h_mm, ny),
+               cavity / max(cavity.max(), 1e-12), levels=[0.5], colors="white", linewidths=1.0)
+    ax.set_xlabel("x [mm] (shoe travel)")
+    ax.set_ylabel("y [mm]")
+    ax.set_title("Fill density, column average (top view)")
+    fig.colorbar(im, ax=ax, label="solid fraction [-]")
+    fig.tight_layout()
+    fig.savefig(out_dir / "top_view.png", dpi=120)
+    plt.close(fig)
+
+    section = np.ma.masked_less(np.array(data["section"], dtype=float).T, 0)
+    fig, ax = plt.subplots(figsize=(6, 4))
+    im = ax.imshow(section, origin="lower", extent=[ox, ox + nx * h_mm, oz, oz + nz * h_mm], cmap="viridis",
+                   vmin=lo, vmax=hi, interpolation="nearest", aspect="equal")
+    ax.set_xlabel("x [mm]")
+    ax.set_ylabel("z [mm]")
+    ax.set_title(f"Vertical section at y = {data['section_y_m'] * 1e3:.2f} mm")
+    fig.colorbar(im, ax=ax, label="solid fraction [-]")
+    fig.tight_layout()
+    fig.savefig(out_dir / "section.png", dpi=120)
+    plt.close(fig)
+
+    fig, ax = plt.subplots(figsize=(6, 4))
+    if values.size:
+        ax.hist(values, bins=40, weights=np.array(data["histogram_weights"]), color="tab:blue")
+        ax.axvline(data["mean"], color="k", linestyle="--", label=f"mean {data['mean']:.3f}")
+        ax.legend()
+    ax.set_xlabel("solid fraction [-]")
+    ax.set_ylabel("cavity volume [voxels]")
+    ax.set_title("Distribution of the fill density")
+    fig.tight_layout()
+    fig.savefig(out_dir / "histogram.png", dpi=120)
+    plt.close(fig)
+
+    profiles = data.get("profiles", {})
+    fig, axes = plt.subplots(1, 3, figsize=(12, 3.6))
+    for ax, (axis, label) in zip(axes, [("z", "height z [mm]"), ("r", "radius from the die axis [mm]"), ("x", "x along the shoe path [mm]")]):
+        if axis in profiles:
+            p = profiles[axis]
+            ax.plot(np.array(p["position_m"]) * 1e3, p["solid_fraction"], marker="o", markersize=3)
+        ax.set_xlabel(label)
+        ax.set_ylabel("solid fraction [-]")
+        ax.grid(alpha=0.3)
+    fig.suptitle("Fill density profiles")
+    fig.tight_layout()
+    fig.savefig(out_dir / "profiles.png", dpi=120)
+    plt.close(fig)
+
+
+if __name__ == "__main__":
+    main(Path(sys.argv[1]))
