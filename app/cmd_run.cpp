@@ -1,13 +1,15 @@
-// `diefill run`: the pipeline. So far the mesh stage: each die is imported, checked, repaired
-// and turned into its signed-distance field; the DEM and density stages follow.
+// `diefill run TARGET`: the pipeline on a die mesh, on every mesh of a folder, or on a scene.
+// `diefill scene [TARGET]`: the resolved scene, every default with its reason.
 #include <fmt/core.h>
 
-#include <nlohmann/json.hpp>
+#include <algorithm>
 
 #include "app/commands.hpp"
+#include "app/pipeline.hpp"
+#include "app/run_loop.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
-#include "mesh/die.hpp"
+#include "core/log.hpp"
 
 namespace app {
 
@@ -15,44 +17,85 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::vector<fs::path> die_files(const fs::path& target) {
-  if (!fs::is_directory(target)) return {target};
+bool is_scene(const fs::path& p) { return p.extension() == ".toml"; }
+
+PipelineScene scene_for(const fs::path& target, const std::vector<std::string>& overrides) {
+  PipelineScene scene = is_scene(target) ? load_pipeline_scene(target, overrides) : load_pipeline_scene(std::nullopt, overrides);
+  if (!is_scene(target) && !target.empty()) scene.die = target;
+  return scene;
+}
+
+void apply_command_line(PipelineScene& scene, const RunCommand& c) {
+  if (!c.out.empty()) scene.out = c.out;
+  if (c.threads) scene.threads = *c.threads;
+  if (c.seed) scene.seed = *c.seed;
+}
+
+std::vector<fs::path> meshes_in(const fs::path& folder) {
   std::vector<fs::path> files;
-  for (const auto& entry : fs::directory_iterator(target))
-    if (entry.is_regular_file()) files.push_back(entry.path());
+  for (const auto& entry : fs::directory_iterator(folder))
+    if (entry.is_regular_file() && !is_scene(entry.path()) && entry.path().extension() != ".md") files.push_back(entry.path());
   std::sort(files.begin(), files.end());
   if (files.empty())
-    throw diefill::InputError(target.string(), "", "the folder holds no mesh files",
-                              "Put die meshes (STL, OBJ, PLY, ...) into it");
+    throw diefill::InputError(folder.string(), "", "the folder holds no mesh files", "Put die meshes (STL, OBJ, PLY, ...) into it");
   return files;
 }
 
 }  // namespace
 
-int run_pipeline(const RunCommand& c) {
-  mesh::DieOptions options = mesh::die_options_for_grains(0.5e-3, 0.25e-3);
-  options.unit = mesh::parse_unit(c.units, "--units");
-  for (const fs::path& file : die_files(c.target)) {
-    const mesh::PreparedDie die = mesh::prepare_die(file, options, c.out / ".cache");
-    const fs::path dir = c.out / die.name;
-    die.sdf.write(dir / "sdf.vdb");
-    const nlohmann::json report = {
-        {"die",
-         {{"name", die.name},
-          {"source", die.source},
-          {"sha256", die.sha256},
-          {"cavity_volume_m3", die.after.volume_m3},
-          {"triangles", die.before.triangles},
-          {"repaired", !die.actions.empty()},
-          {"repairs", die.actions}}}};
-    diefill::write_file_atomic(dir / "report.json", report.dump(2) + "\n");
-    fmt::print("{}: mesh stage done ({} triangles, {} voxels{}) -> {}\n", die.name,
-               die.after.triangles, die.sdf.active_voxels(), die.sdf_from_cache ? ", cached" : "",
-               dir.string());
-  }
-  fmt::print("note: the DEM, density and report stages are not built yet; this run stops after "
-             "the mesh stage\n");
+int run_scene(const SceneCommand& c) {
+  fmt::print("{}", describe(scene_for(c.target, c.overrides)));
   return 0;
+}
+
+int run_pipeline(const RunCommand& c) {
+  install_interrupt_handler();
+  if (!fs::is_directory(c.target)) {
+    PipelineScene scene = scene_for(c.target, c.overrides);
+    apply_command_line(scene, c);
+    if (scene.die.empty())
+      throw diefill::InputError(c.target.string(), "die.file", "names no die", "Give [die] file = \"...\" or run a mesh");
+    const DieRun run = run_die_fill(scene, scene.die, c.resume);
+    if (run.interrupted) {
+      fmt::print(stderr, "interrupted; resume with `diefill run {} --resume`\n", c.target.string());
+      return 130;
+    }
+    fmt::print("{}: report {}\n", run.die, (run.dir / "report.json").string());
+    return 0;
+  }
+  // A folder: every mesh into its own folder, then a summary table.
+  PipelineScene scene = scene_for({}, c.overrides);
+  apply_command_line(scene, c);
+  std::string csv = "die,status,grains_in_cavity,fill_ratio,solid_fraction_mean,solid_fraction_std,solid_fraction_min,solid_fraction_max,message\n";
+  std::string md = "| die | status | grains in cavity | fill ratio | mean | std | min | max |\n|---|---|---|---|---|---|---|---|\n";
+  int failures = 0;
+  for (const fs::path& mesh : meshes_in(c.target)) {
+    try {
+      const DieRun run = run_die_fill(scene, mesh, c.resume);
+      if (run.interrupted) return 130;
+      const auto& fill = run.report["fill"];
+      const auto value = [&](const char* key) { return fill.value(key, 0.0); };
+      csv += fmt::format("{},ok,{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},\n", run.die, run.report["particles"]["in_cavity"].get<std::size_t>(),
+                         value("fill_ratio"), value("solid_fraction_mean"), value("solid_fraction_std"),
+                         value("solid_fraction_min"), value("solid_fraction_max"));
+      md += fmt::format("| {} | ok | {} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} |\n", run.die,
+                        run.report["particles"]["in_cavity"].get<std::size_t>(), value("fill_ratio"),
+                        value("solid_fraction_mean"), value("solid_fraction_std"), value("solid_fraction_min"),
+                        value("solid_fraction_max"));
+    } catch (const diefill::InputError& e) {
+      ++failures;
+      fmt::print(stderr, "error: {}\n", e.what());
+      std::string message = e.what();
+      std::replace(message.begin(), message.end(), ',', ';');
+      std::replace(message.begin(), message.end(), '|', '/');
+      csv += fmt::format("{},refused,,,,,,,{}\n", mesh.stem().string(), message);
+      md += fmt::format("| {} | refused: {} | | | | | | |\n", mesh.stem().string(), message);
+    }
+  }
+  diefill::write_file_atomic(scene.out / "summary.csv", csv);
+  diefill::write_file_atomic(scene.out / "summary.md", md);
+  fmt::print("{}", md);
+  return failures > 0 ? diefill::exit_bad_input : 0;
 }
 
 }  // namespace app

@@ -28,11 +28,20 @@ struct SdfCommand {
 int run_sdf(const SdfCommand& command);
 
 struct RunCommand {
-  std::filesystem::path target;  // a die mesh or a folder of them
-  std::filesystem::path out = "out";
-  std::string units = "mm";
+  std::filesystem::path target;  // a die mesh, a folder of them, or a scene (.toml)
+  std::filesystem::path out;     // overrides output.directory
+  std::vector<std::string> overrides;
+  std::optional<int> threads;
+  std::optional<std::uint64_t> seed;
+  bool resume = false;
 };
 int run_pipeline(const RunCommand& command);
+
+struct SceneCommand {
+  std::filesystem::path target;
+  std::vector<std::string> overrides;
+};
+int run_scene(const SceneCommand& command);
 
 struct SimulateCommand {
   std::filesystem::path scene;

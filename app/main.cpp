@@ -27,11 +27,21 @@ void add_sdf(CLI::App& root, app::SdfCommand& c, std::function<int()>& action) {
 }
 
 void add_run(CLI::App& root, app::RunCommand& c, std::function<int()>& action) {
-  CLI::App* cmd = root.add_subcommand("run", "The whole pipeline on a die mesh or on every mesh of a folder");
-  cmd->add_option("TARGET", c.target, "Die mesh or folder of meshes")->required();
-  cmd->add_option("--out", c.out, "Output folder; each die writes into OUT/<die name>/")->capture_default_str();
-  cmd->add_option("--units", c.units, "Length unit of the meshes: mm, m or in")->capture_default_str();
+  CLI::App* cmd = root.add_subcommand("run", "The whole pipeline on a die mesh, a folder of meshes, or a scene");
+  cmd->add_option("TARGET", c.target, "Die mesh, folder of meshes, or scene (.toml)")->required();
+  cmd->add_option("--out", c.out, "Output folder; each die writes into OUT/<die name>/ (default out)");
+  cmd->add_option("--set", c.overrides, "Override a scene key: --set motion.speed=0.2");
+  cmd->add_option("--threads", c.threads, "Threads (default: all cores); results do not depend on it");
+  cmd->add_option("--seed", c.seed, "Random seed of the powder");
+  cmd->add_flag("--resume", c.resume, "Continue an interrupted run from its checkpoint");
   cmd->callback([&] { action = [&] { return app::run_pipeline(c); }; });
+}
+
+void add_scene(CLI::App& root, app::SceneCommand& c, std::function<int()>& action) {
+  CLI::App* cmd = root.add_subcommand("scene", "Print the fully resolved scene (every default, with its reason)");
+  cmd->add_option("TARGET", c.target, "Die mesh or scene (.toml)");
+  cmd->add_option("--set", c.overrides, "Override a scene key");
+  cmd->callback([&] { action = [&] { return app::run_scene(c); }; });
 }
 
 void add_simulate(CLI::App& root, app::SimulateCommand& c, std::function<int()>& action) {
@@ -93,6 +103,8 @@ int main(int argc, char** argv) {
   app::DieCommand die;
   app::RunCommand run;
   add_run(root, run, action);
+  app::SceneCommand scene;
+  add_scene(root, scene, action);
   app::SimulateCommand simulate;
   add_simulate(root, simulate, action);
   app::BenchCommand bench;

@@ -1,6 +1,7 @@
 #pragma once
 // The simulation's Model (immutable while stepping) and the spec it is compiled from, after
 // MuJoCo's mjModel/mjData split: every stage is `void stage(const Model&, State&)`.
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -43,6 +44,12 @@ struct MeshWall {
   int material = 0;
   Motion motion;
   std::string name = "mesh";
+  // Grains whose centre lies below this height pass under the wall untouched, and those above
+  // overlap it no deeper than their height above it: a feed shoe cuts the fill at the die
+  // table, and a coarse grain stands for a lump of powder that the cut assigns by its centre.
+  // Without the cut a rigid shoe pinches any grain straddling the cavity's rim against the far
+  // cavity wall, where it can neither rise nor sink.
+  double passes_below_z = -std::numeric_limits<double>::infinity();
 };
 
 struct Box3 {

@@ -8,6 +8,7 @@
 #include "core/timer.hpp"
 #include "dem/forces.hpp"
 #include "dem/neighbours.hpp"
+#include "dem/walls.hpp"
 
 namespace dem {
 
@@ -40,6 +41,37 @@ void forces(const Model& model, State& s, StageTimes* times) {
   if (times) times->wall_forces += clock.seconds();
 }
 
+// Which contact overlaps most, for the stop message: a serial scan, run once when stopping.
+std::string worst_overlap(const Model& model, const State& s) {
+  double worst = -1;
+  std::string where;
+  const NeighbourList& nl = s.neighbours;
+  for (std::size_t i = 0; i + 1 < nl.row_start.size(); ++i) {
+    if (!s.active[i]) continue;
+    for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p) {
+      const std::size_t j = std::size_t(nl.partner[std::size_t(p)]);
+      const double rel = (s.radius[i] + s.radius[j] - (s.x[i] - s.x[j]).norm()) / std::min(s.radius[i], s.radius[j]);
+      if (rel > worst)
+        worst = rel, where = fmt::format("grains {} and {} at ({:.4g}, {:.4g}, {:.4g}) mm", s.id[i], s.id[j],
+                                         1e3 * s.x[i].x(), 1e3 * s.x[i].y(), 1e3 * s.x[i].z());
+    }
+  }
+  WallHit hits[wall_slots_per_particle];
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (!s.active[i]) continue;
+    const int count = wall_hits(model, s.time, s.x[i], s.radius[i], hits, wall_slots_per_particle);
+    for (int k = 0; k < count; ++k) {
+      const double rel = (s.radius[i] - hits[k].distance) / s.radius[i];
+      const std::size_t w = std::size_t(hits[k].wall);
+      const std::string& wall = w < model.planes.size() ? model.planes[w].name : model.meshes[w - model.planes.size()].name;
+      if (rel > worst)
+        worst = rel, where = fmt::format("grain {} and the wall \"{}\" at ({:.4g}, {:.4g}, {:.4g}) mm", s.id[i], wall,
+                                         1e3 * s.x[i].x(), 1e3 * s.x[i].y(), 1e3 * s.x[i].z());
+    }
+  }
+  return where;
+}
+
 // Mechanical energy may only grow by what walls deliver; checked every `energy_interval` steps.
 constexpr int energy_interval = 200;
 
@@ -49,10 +81,10 @@ StepReport monitor(const Model& model, State& s) {
   if (s.counters.max_overlap_rel > model.stop_overlap) {
     r.status = StepStatus::overlap;
     r.message = fmt::format(
-        "a contact overlap reached {:.3g} of the grain radius (limit {:.3g}) at t = {:.6g} s: the "
-        "time step {:.3g} s is too large for the stiffness or the impact speed. Lower "
-        "simulation.time_step (or its fraction), soften the material, or slow the walls",
-        s.counters.max_overlap_rel, model.stop_overlap, s.time, model.dt);
+        "a contact overlap reached {:.3g} of the grain radius (limit {:.3g}) at t = {:.6g} s, between {}: "
+        "the time step {:.3g} s is too large for the stiffness or the impact speed, or a moving wall "
+        "pinches grains. Lower simulation.time_step (or its fraction), soften the material, or slow the walls",
+        s.counters.max_overlap_rel, model.stop_overlap, s.time, worst_overlap(model, s), model.dt);
     return r;
   }
   if (s.step % energy_interval != 0) return r;

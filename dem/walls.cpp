@@ -15,6 +15,8 @@ int wall_hits(const Model& model, double time, const Vec3& x, double r, WallHit*
   }
   for (std::size_t m = 0; m < model.meshes.size() && count < capacity; ++m) {
     const MeshWall& wall = model.meshes[m];
+    const double height_above_cut = x.z() - wall.passes_below_z;
+    if (height_above_cut <= 0) continue;
     const bool moving = model.mesh_moves[m];
     const Vec3 local = moving ? wall.motion.to_local(time, x) : x;
     mesh::SurfacePoint minima[wall_slots_per_particle];
@@ -29,8 +31,12 @@ int wall_hits(const Model& model, double time, const Vec3& x, double r, WallHit*
     const Quat q = moving ? wall.motion.orientation(time) : Quat::Identity();
     for (int k = 0; k < n && count < capacity; ++k) {
       const Vec3 normal = moving ? Vec3(q * minima[k].normal) : minima[k].normal;
-      const Vec3 point = x - minima[k].distance * normal;
-      out[count++] = {std::int32_t(model.planes.size() + m), normal, minima[k].distance, point,
+      // Overlap no deeper than the centre's height above the cut: the push fades to nothing at
+      // the cut, so a grain that was passed under and rises meets no sudden force, and a grain
+      // pinched at the rim is cut rather than crushed.
+      const double distance = std::max(minima[k].distance, r - height_above_cut);
+      const Vec3 point = x - distance * normal;
+      out[count++] = {std::int32_t(model.planes.size() + m), normal, distance, point,
                       moving ? wall.motion.point_velocity(time, point) : Vec3(Vec3::Zero()),
                       wall.motion.angular_velocity};
     }

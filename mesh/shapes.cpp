@@ -94,6 +94,30 @@ TriMesh box_solid(const Vec3& lo, const Vec3& hi) {
   return m;
 }
 
+TriMesh shoe_solid(double inner_length, double inner_width, double height, double thickness) {
+  // A rectangular tube: outer and inner rectangles at z = 0 and z = height, joined.
+  TriMesh m;
+  const double ix = inner_length / 2, iy = inner_width / 2, ox = ix + thickness, oy = iy + thickness;
+  const double xs[2][4] = {{-ox, ox, ox, -ox}, {-ix, ix, ix, -ix}};
+  const double ys[2][4] = {{-oy, -oy, oy, oy}, {-iy, -iy, iy, iy}};
+  auto vertex = [&](int ring, int corner, int top) { return ring * 8 + top * 4 + corner; };
+  for (int ring = 0; ring < 2; ++ring)
+    for (int top = 0; top < 2; ++top)
+      for (int c = 0; c < 4; ++c) m.vertices.emplace_back(xs[ring][c], ys[ring][c], top ? height : 0.0);
+  auto quad = [&](int a, int b, int c, int d) {
+    m.triangles.push_back({a, b, c});
+    m.triangles.push_back({a, c, d});
+  };
+  for (int c = 0; c < 4; ++c) {
+    const int n = (c + 1) % 4;
+    quad(vertex(0, c, 0), vertex(0, n, 0), vertex(0, n, 1), vertex(0, c, 1));  // outer side, facing out
+    quad(vertex(1, n, 0), vertex(1, c, 0), vertex(1, c, 1), vertex(1, n, 1));  // inner side, facing in
+    quad(vertex(0, c, 1), vertex(0, n, 1), vertex(1, n, 1), vertex(1, c, 1));  // top rim, +z
+    quad(vertex(0, n, 0), vertex(0, c, 0), vertex(1, c, 0), vertex(1, n, 0));  // bottom rim, -z
+  }
+  return m;
+}
+
 std::vector<std::string> bundled_die_names() { return {"disc", "ring"}; }
 
 TriMesh bundled_die(const std::string& name) {

@@ -16,6 +16,11 @@ TriMesh ring_cavity(double outer_diameter, double inner_diameter, double depth, 
 // Axis-aligned box [lo, hi], outward-oriented, two triangles a face.
 TriMesh box_solid(const Vec3& lo, const Vec3& hi);
 
+// A feeding shoe: four walls of `thickness` around an inner rectangle (x along the motion,
+// y across), from z = 0 to `height`, open at the bottom and the top. Outward-oriented, closed;
+// the inner rectangle is centred on the origin.
+TriMesh shoe_solid(double inner_length, double inner_width, double height, double thickness);
+
 // The bundled dies by name ("ring", "disc"); throws InputError for other names.
 TriMesh bundled_die(const std::string& name);
 std::vector<std::string> bundled_die_names();

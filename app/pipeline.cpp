@@ -1,0 +1,337 @@
+#include "app/pipeline.hpp"
+
+#include <fmt/core.h>
+#include <omp.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "app/density_stage.hpp"
+#include "app/run_loop.hpp"
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/sha256.hpp"
+#include "core/timer.hpp"
+#include "dem/checkpoint.hpp"
+#include "dem/insert.hpp"
+#include "dem/io.hpp"
+#include "dem/neighbours.hpp"
+#include "dem/step.hpp"
+#include "mesh/die.hpp"
+#include "mesh/shapes.hpp"
+
+namespace app {
+
+namespace fs = std::filesystem;
+using diefill::InputError;
+using dem::Vec3;
+
+namespace {
+
+int material_named(const dem::ModelSpec& spec, const std::string& name) {
+  for (std::size_t m = 0; m < spec.materials.size(); ++m)
+    if (spec.materials[m].name == name) return int(m);
+  throw InputError("scene", "materials", "has no material named \"" + name + "\"", "Define it");
+}
+
+// Where the shoe goes: its inner rectangle centred at (x, y_centre) on the table.
+struct ShoePlan {
+  double length, width;        // inner [m] (width after trimming)
+  double x_start, x_end;       // shoe centre at the start and the end of a pass
+  double y_centre;
+  double t_motion;             // duration of the whole motion [s]
+  dem::Motion motion;          // of the shoe's frame (origin at its inner centre, on the table)
+};
+
+// Accelerate to v, cruise, decelerate to rest over `distance` (signed along x).
+void add_stroke(dem::Motion& m, double distance, double v, double a) {
+  const double sign = distance < 0 ? -1 : 1, d = std::abs(distance);
+  double ta = v / a, cruise = d - v * ta;
+  if (cruise < 0) ta = std::sqrt(d / a), cruise = 0;  // never reaches v
+  m.segments.push_back({ta, Vec3(sign * a, 0, 0)});
+  if (cruise > 0) m.segments.push_back({cruise / (a * ta), Vec3::Zero()});  // a ta = v
+  m.segments.push_back({ta, Vec3(-sign * a, 0, 0)});
+}
+
+ShoePlan plan_shoe(const PipelineScene& s, const mesh::Box& die_box, double table_z) {
+  ShoePlan p;
+  p.length = s.shoe_length;
+  const double die_width = die_box.size().y();
+  p.width = s.trim_width ? std::min(s.shoe_width, die_width + 2 * s.side_margin) : s.shoe_width;
+  if (p.width < die_width + 2 * s.side_margin) {
+    diefill::log::warn("the shoe ({:.4g} mm wide) does not cover the die ({:.4g} mm) with its side margin; widened to {:.4g} mm",
+                       s.shoe_width * 1e3, die_width * 1e3, (die_width + 2 * s.side_margin) * 1e3);
+    p.width = die_width + 2 * s.side_margin;
+  }
+  p.y_centre = 0.5 * (die_box.lo.y() + die_box.hi.y());
+  p.x_start = die_box.lo.x() - s.start_gap - 0.5 * p.length;
+  p.x_end = die_box.hi.x() + s.end_gap + 0.5 * p.length;
+  p.motion.start_position = Vec3(p.x_start, p.y_centre, table_z);  // raised by the clearance once grains are sized
+  for (int pass = 0; pass < s.passes; ++pass) {
+    add_stroke(p.motion, p.x_end - p.x_start, s.speed, s.acceleration);
+    if (s.dwell > 0) p.motion.segments.push_back({s.dwell, Vec3::Zero()});
+    if (s.return_stroke) add_stroke(p.motion, p.x_start - p.x_end, s.speed, s.acceleration);
+  }
+  p.t_motion = 0;
+  for (const auto& seg : p.motion.segments) p.t_motion += seg.duration;
+  return p;
+}
+
+// The scene less what happens after the shoe has settled (its motion, the die's settling, the
+// density field, the output): the key of the cached settled shoe.
+PipelineScene settling_part(const PipelineScene& s) {
+  PipelineScene part = s;
+  const PipelineScene defaults;
+  part.speed = defaults.speed, part.acceleration = defaults.acceleration, part.end_gap = defaults.end_gap;
+  part.dwell = defaults.dwell, part.passes = defaults.passes, part.return_stroke = defaults.return_stroke;
+  part.die_settle_time = defaults.die_settle_time;
+  part.density_voxel = defaults.density_voxel, part.density_method = defaults.density_method;
+  part.out = defaults.out, part.snapshot_every = defaults.snapshot_every, part.threads = defaults.threads;
+  part.source = defaults.source;
+  return part;
+}
+
+}  // namespace
+
+DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resume) {
+  diefill::Stopwatch wall_clock;
+  if (s.threads > 0) omp_set_num_threads(s.threads);
+  if (!s.shape_mesh.empty())
+    throw InputError(s.source, "powder.shape", "multi-sphere grains are not simulated yet; the run would use spheres",
+                     "Remove powder.shape to fill the die with spheres");
+  const int powder = material_named(s.spec, "powder"), steel = material_named(s.spec, "steel");
+  double diameter = s.grain_diameter();
+  const double spread = s.diameter_spread;
+
+  // 1. The die: cavity, tool and SDF over a table as long as the shoe's travel.
+  mesh::DieOptions die_options = mesh::die_options_for_grains(0.5 * diameter * (1 + spread), 0.25 * diameter * (1 + spread));
+  die_options.unit = mesh::parse_unit(s.die_units, "die.units");
+  die_options.role = mesh::parse_role(s.die_role, "die.role");
+  if (die_options.role != mesh::WallRole::cavity)
+    throw InputError(die_mesh.string(), "die.role", "the pipeline fills a cavity", "Give the cavity mesh (role \"cavity\")");
+  const mesh::ImportResult preview = mesh::import_mesh(die_mesh, {die_options.unit});
+  const mesh::Box box = mesh::bounding_box(preview.mesh);
+  const double table_z = box.hi.z();
+  // Coarser grains when the powder would need too many: the shoe's powder over the die.
+  ShoePlan plan = plan_shoe(s, box, table_z);
+  const double grain_volume = std::numbers::pi / 6 * diameter * diameter * diameter;
+  double estimate = plan.length * plan.width * s.fill_height * 0.6 / grain_volume;
+  if (estimate > double(s.max_grains)) {
+    const double scale = std::cbrt(estimate / double(s.max_grains));
+    diefill::log::warn("{}: {:.0f} grains of {:.3g} mm would exceed powder.max_grains = {}; using {:.3g} mm grains "
+                       "(coarse graining {:.3g} instead of {:.3g})",
+                       die_mesh.string(), estimate, diameter * 1e3, s.max_grains, diameter * scale * 1e3,
+                       s.coarse_graining * scale, s.coarse_graining);
+    diameter *= scale;
+    estimate = double(s.max_grains);
+    die_options = mesh::die_options_for_grains(0.5 * diameter * (1 + spread), 0.25 * diameter * (1 + spread));
+    die_options.unit = mesh::parse_unit(s.die_units, "die.units");
+  }
+  const double r_max = 0.5 * diameter * (1 + spread);
+  plan.motion.start_position.z() = table_z + s.clearance * r_max;
+  const double margin = 2e-3 + 2 * r_max;
+  die_options.table = mesh::TableExtent{plan.x_start - 0.5 * plan.length - s.shoe_wall - margin,
+                                        plan.y_centre - 0.5 * plan.width - s.shoe_wall - margin,
+                                        plan.x_end + 0.5 * plan.length + s.shoe_wall + margin,
+                                        plan.y_centre + 0.5 * plan.width + s.shoe_wall + margin, 2e-3};
+  const fs::path cache = s.out / ".cache";
+  const mesh::PreparedDie die = mesh::prepare_die(die_mesh, die_options, cache);
+  const fs::path dir = s.out / die.name;
+  fs::create_directories(dir);
+
+  // 2. The shoe: a rectangular tube, its own SDF, moving rigidly on the table.
+  //    A shoe from a mesh is a tool in its own frame: origin at the inner centre, on the table.
+  const double shoe_voxel = 0.5 * r_max;  // the query is exact; the voxels only find candidates
+  std::shared_ptr<const mesh::WallField> shoe_field;
+  if (!s.shoe_mesh.empty()) {
+    mesh::DieOptions shoe_options = mesh::die_options_for_grains(r_max, 0.5 * r_max, shoe_voxel);
+    shoe_options.unit = die_options.unit;
+    shoe_options.role = mesh::WallRole::tool;
+    const mesh::PreparedDie shoe_die = mesh::prepare_die(s.shoe_mesh, shoe_options, cache);
+    shoe_field = std::make_shared<const mesh::WallField>(shoe_die.sdf.wall_field(shoe_die.solid));
+  } else {
+    mesh::SdfOptions shoe_sdf{shoe_voxel, r_max + 0.5 * r_max + shoe_voxel, 2 * shoe_voxel, false};
+    const mesh::TriMesh shoe_mesh = mesh::shoe_solid(plan.length, plan.width, s.shoe_height, s.shoe_wall);
+    shoe_field = std::make_shared<const mesh::WallField>(mesh::build_sdf(shoe_mesh, shoe_sdf).wall_field(shoe_mesh));
+  }
+  auto die_field = std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid));
+
+  dem::ModelSpec spec = s.spec;
+  spec.domain = {Vec3(die_options.table->x_min, die_options.table->y_min, box.lo.z() - 1e-3),
+                 Vec3(die_options.table->x_max, die_options.table->y_max, table_z + s.shoe_height + 5e-3)};
+  dem::MeshWall die_wall;
+  die_wall.field = die_field, die_wall.material = steel, die_wall.name = "die";
+  spec.meshes.push_back(die_wall);
+  dem::MeshWall shoe;
+  shoe.field = shoe_field, shoe.material = steel, shoe.name = "shoe";
+  shoe.motion.start_position = plan.motion.start_position;
+  shoe.passes_below_z = table_z + 0.5 * r_max;  // the grain on the rim edge then rides up (slope 30° > friction) or is cut
+  spec.meshes.push_back(shoe);
+
+  // 3. Fill the shoe and let the powder settle, at rest at its start; cached by everything that
+  //    shapes it, and always resumed from the cached positions so that a cached and a fresh run
+  //    give the same result.
+  const std::string shoe_key = diefill::sha256_hex(fmt::format(
+      "v2;{};{};{:a};{:a};{:a};{:a};{:a};{:a};{:a};{:a};{};{}", die.cache_key, describe(settling_part(s)), diameter, plan.length,
+      plan.width, plan.x_start, plan.y_centre, s.fill_height, s.shoe_settle_time, table_z, s.seed, powder));
+  const fs::path settled = cache / ("shoe-" + shoe_key + ".csv");
+  const double density = spec.materials[std::size_t(powder)].density;
+  if (!fs::exists(settled)) {
+    dem::State fill;
+    dem::InsertRegion region;
+    const double inset = r_max + 1e-6;
+    region.box = {Vec3(plan.x_start - 0.5 * plan.length + inset, plan.y_centre - 0.5 * plan.width + inset, table_z + inset),
+                  Vec3(plan.x_start + 0.5 * plan.length - inset, plan.y_centre + 0.5 * plan.width - inset,
+                       table_z + std::min(s.shoe_height - inset, s.fill_height * 0.6 / 0.38 + 2 * r_max))};
+    dem::InsertRequest request;
+    request.count = std::size_t(estimate);
+    request.radius = 0.5 * diameter;
+    request.radius_spread = spread;
+    request.material = powder;
+    request.density = density;
+    request.seed = s.seed;
+    request.max_solid_fraction = 0.45;
+    const std::size_t inserted = dem::insert_spheres(fill, region, request);
+    diefill::log::info("{}: settling {} grains of {:.3g} mm in the shoe ({:.3g} x {:.3g} mm, once; cached)", die.name,
+                       inserted, diameter * 1e3, plan.length * 1e3, plan.width * 1e3);
+    const dem::Model settle_model = dem::compile_model(spec, fill, s.source);
+    dem::initialize(settle_model, fill);
+    LoopOptions loop;
+    loop.until = s.shoe_settle_time;
+    loop.label = die.name + ": settling the shoe";
+    run_until(settle_model, fill, loop);
+    dem::write_particles_csv(fill, settled);
+  }
+  dem::State state = dem::read_particles_csv(settled, powder, density);
+  for (Vec3& v : state.v) v.setZero();
+  for (Vec3& w : state.w) w.setZero();
+  const std::size_t inserted = state.size();
+
+  // 4. Move the shoe, then let the die settle.
+  spec.meshes[1].motion = plan.motion;
+  const dem::Model model = dem::compile_model(spec, state, s.source);
+  const fs::path checkpoint = dir / "checkpoint.bin";
+  if (resume && fs::exists(checkpoint)) {
+    state = dem::read_checkpoint(model, checkpoint);
+    diefill::log::info("{}: resumed at t = {:.6g} s", die.name, state.time);
+  } else {
+    dem::initialize(model, state);
+  }
+  auto in_cavity = [&](const dem::State& st) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < st.size(); ++i) n += st.active[i] && st.x[i].z() < table_z;
+    return n;
+  };
+  LoopOptions loop;
+  loop.until = plan.t_motion + s.die_settle_time;
+  loop.label = die.name + ": filling";
+  loop.checkpoint = checkpoint;
+  int snapshot = 0;
+  if (s.snapshot_every > 0) {
+    loop.output_every = s.snapshot_every;
+    loop.output = [&](const dem::State& st) { dem::write_vtu(st, dir / fmt::format("snapshot_{:05d}.vtu", snapshot++)); };
+  }
+  loop.detail = [&](const dem::State& st) { return fmt::format("{} grains in the cavity", in_cavity(st)); };
+  const LoopResult result = run_until(model, state, loop);
+  DieRun run;
+  run.die = die.name;
+  run.dir = dir;
+  if (result.interrupted) {
+    run.interrupted = true;
+    return run;
+  }
+  fs::remove(checkpoint);
+
+  // 5. Count every grain.
+  const Vec3 shoe_centre = plan.motion.position(state.time);
+  std::size_t cavity = 0, in_shoe = 0, elsewhere = 0;
+  std::vector<post::Grain> grains;
+  for (std::size_t i = 0; i < state.size(); ++i) {
+    if (!state.active[i]) continue;
+    const Vec3& x = state.x[i];
+    if (x.z() < table_z) {
+      ++cavity;
+      grains.push_back({x, state.radius[i], 1.0});
+    } else if (std::abs(x.x() - shoe_centre.x()) < 0.5 * plan.length && std::abs(x.y() - shoe_centre.y()) < 0.5 * plan.width) {
+      ++in_shoe;
+    } else {
+      ++elsewhere;
+    }
+  }
+  if (state.lost > 0)
+    throw InputError(die_mesh.string(), "particles.lost",
+                     fmt::format("{} grains left the simulated domain (through the walls or over the table's edge)", state.lost),
+                     "Check the die mesh for holes, or lower the shoe speed");
+
+  // 6. Density, report, pictures: staged, so that a failure keeps the earlier outputs.
+  diefill::StagingFolder out(dir);
+  DensitySettings ds;
+  ds.voxel_m = s.density_voxel > 0 ? s.density_voxel : 2 * diameter;
+  ds.method = s.density_method;
+  nlohmann::json fill_json;
+  if (!grains.empty()) {
+    const DensityResult field = compute_density(grains, die, *die_field, density, ds, die.name);
+    auto metadata = [&](DensityResult r) {
+      r.field.metadata["coarse_graining"] = fmt::format("{}", diameter / s.particle_diameter);
+      r.field.metadata["die"] = die.name;
+      return r;
+    };
+    const DensityResult tagged = metadata(field);
+    write_density(tagged, out.path());
+    fill_json = statistics_json(field.stats);
+  } else {
+    diefill::log::warn("{}: no grain entered the cavity; no density field", die.name);
+    fill_json = {{"mass_kg", 0.0}, {"fill_ratio", 0.0}};
+  }
+  dem::write_particles_csv(state, out / "particles.csv");
+  dem::write_vtu(state, out / "final.vtu");
+  diefill::write_file_atomic(out / "scene.toml", describe(s));
+  double grain_volume_total = 0;
+  for (std::size_t i = 0; i < state.size(); ++i) grain_volume_total += 4.0 / 3.0 * std::numbers::pi * std::pow(state.radius[i], 3);
+  const double steps = double(result.steps);
+  nlohmann::json report = {
+      {"die",
+       {{"name", die.name},
+        {"source", die.source},
+        {"sha256", die.sha256},
+        {"cavity_volume_m3", die.after.volume_m3},
+        {"triangles", die.before.triangles},
+        {"repaired", !die.actions.empty()},
+        {"repairs", die.actions},
+        {"table_z_m", table_z}}},
+      {"powder",
+       {{"grains", inserted},
+        {"grain_volume_m3", grain_volume_total},
+        {"material_density", density},
+        {"coarse_graining", diameter / s.particle_diameter},
+        {"grain_diameter_m", diameter},
+        {"shape", "sphere"}}},
+      {"shoe", {{"length_m", plan.length}, {"width_m", plan.width}, {"speed_m_s", s.speed}, {"passes", s.passes}}},
+      {"fill", fill_json},
+      {"particles", {{"inserted", inserted}, {"in_cavity", cavity}, {"in_shoe", in_shoe}, {"elsewhere", elsewhere}, {"lost", state.lost}}},
+      {"timing",
+       {{"wall_s", wall_clock.seconds()},
+        {"steps", result.steps},
+        {"dt_s", model.dt},
+        {"particle_steps_per_s", steps * double(inserted) / std::max(1e-9, result.wall_s)},
+        {"stages",
+         {{"neighbours", result.times.neighbours},
+          {"pair_forces", result.times.pair_forces},
+          {"sums", result.times.sums},
+          {"wall_forces", result.times.wall_forces},
+          {"integration", result.times.integration},
+          {"monitor", result.times.monitor}}}}},
+      {"stability",
+       {{"max_overlap_rel", state.counters.max_overlap_rel},
+        {"checks_passed", true},
+        {"warnings", diefill::log::take_warnings()}}}};
+  diefill::write_file_atomic(out / "report.json", report.dump(2) + "\n");
+  out.commit();
+  run.report = report;
+  diefill::log::info("{}: {} of {} grains in the cavity, fill ratio {:.3f}, mean solid fraction {:.3f} -> {}", die.name, cavity,
+                     inserted, fill_json.value("fill_ratio", 0.0), fill_json.value("solid_fraction_mean", 0.0), dir.string());
+  return run;
+}
+
+}  // namespace app
