@@ -143,7 +143,7 @@ std::pair<dem::Model, dem::State> ring_pack(std::size_t count, const fs::path& c
   spec.skin = 0.5 * r;
   spec.gravity = dem::Vec3(0, 0, -9.81);
   spec.domain = {dem::Vec3(-14e-3, -14e-3, -11e-3), dem::Vec3(14e-3, 14e-3, 30e-3)};
-  spec.meshes.push_back({std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid)), 0, {}, "ring"});
+  spec.meshes.push_back(dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid)), 0, "ring"));
   const fs::path packed = cache / fmt::format("ring_pack_{}.csv", count);
   dem::State s;
   if (fs::exists(packed)) {
@@ -203,7 +203,7 @@ int run_bench(const BenchCommand& c) {
       const mesh::Box box = die.after.bbox;
       spec.domain = {dem::Vec3(box.lo.x(), box.lo.y(), box.lo.z()) - dem::Vec3::Constant(1e-3),
                      dem::Vec3(box.hi.x(), box.hi.y(), box.hi.z()) + dem::Vec3::Constant(1e-3)};
-      spec.meshes.push_back({std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid)), 0, {}, "container"});
+      spec.meshes.push_back(dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid)), 0, "container"));
       const dem::Model model = dem::compile_model(spec, pack, c.pack.string());
       json r = time_case(name, model, pack, c.steps, thread_counts);
       r["pack"] = c.pack.string();

@@ -82,4 +82,14 @@ struct DieCommand {
 };
 int run_die(const DieCommand& command);
 
+struct ClumpCommand {
+  std::filesystem::path mesh;
+  std::string units = "mm";
+  double tolerance = 0.05;
+  int max_spheres = 64;
+  std::uint64_t seed = 1;
+  std::filesystem::path output = "out/clumps";
+};
+int run_clump(const ClumpCommand& command);
+
 }  // namespace app

@@ -83,12 +83,14 @@ void write_density(const DensityResult& r, const fs::path& dir) {
   post::write_vdb(r.field, dir / "density.vdb");
   post::write_vti(r.field, dir / "density.vti");
   post::write_plot_data(r.field, r.stats, dir / "plot_data.json");
-  draw_pictures(dir);
+  draw_pictures({"density", dir.string()});
 }
 
-void draw_pictures(const fs::path& dir) {
+void draw_pictures(const std::vector<std::string>& arguments) {
   const fs::path script = fs::path(DIEFILL_SOURCE_DIR) / "postprocess" / "plots.py";
-  const std::string command = fmt::format("/usr/bin/python3 '{}' '{}' 2>&1", script.string(), dir.string());
+  std::string command = fmt::format("/usr/bin/python3 '{}'", script.string());
+  for (const std::string& a : arguments) command += fmt::format(" '{}'", a);
+  command += " 2>&1";
   if (std::system(command.c_str()) != 0)
     diefill::log::warn("the pictures were not drawn ({} failed); install python3-matplotlib (scripts/setup.sh does)", script.string());
 }

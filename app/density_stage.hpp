@@ -35,7 +35,8 @@ nlohmann::json statistics_json(const post::FieldStatistics& stats);
 // density.vdb, density.vti, plot_data.json and the pictures into `dir` (a staging folder).
 void write_density(const DensityResult& result, const std::filesystem::path& dir);
 
-// Runs postprocess/plots.py on `dir`; warns (never fails) when Python or matplotlib is missing.
-void draw_pictures(const std::filesystem::path& dir);
+// Runs postprocess/plots.py with `arguments` (a kind of picture, then its data); warns, never
+// fails, when Python or matplotlib is missing.
+void draw_pictures(const std::vector<std::string>& arguments);
 
 }  // namespace app

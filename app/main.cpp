@@ -87,6 +87,18 @@ void add_die(CLI::App& root, app::DieCommand& c, std::function<int()>& action) {
   cmd->callback([&] { action = [&] { return app::run_die(c); }; });
 }
 
+void add_clump(CLI::App& root, app::ClumpCommand& c, std::function<int()>& action) {
+  CLI::App* cmd = root.add_subcommand("clump", "Build the multi-sphere template of a grain shape, with its errors against the sphere count");
+  cmd->add_option("MESH", c.mesh, "Closed grain surface mesh")->required();
+  cmd->add_option("--units", c.units, "Length unit of the file: mm, m or in")->capture_default_str();
+  cmd->add_option("--tolerance", c.tolerance, "Largest volume and Hausdorff error, relative to the equivalent diameter")
+      ->capture_default_str();
+  cmd->add_option("--max-spheres", c.max_spheres, "Most spheres per grain")->capture_default_str();
+  cmd->add_option("--seed", c.seed, "Seed of the surface sampling")->capture_default_str();
+  cmd->add_option("-o,--output", c.output, "Output folder: NAME.json, NAME_errors.csv, NAME_errors.png")->capture_default_str();
+  cmd->callback([&] { action = [&] { return app::run_clump(c); }; });
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -113,6 +125,8 @@ int main(int argc, char** argv) {
   add_density(root, density, action);
   add_sdf(root, sdf, action);
   add_die(root, die, action);
+  app::ClumpCommand clump;
+  add_clump(root, clump, action);
   try {
     root.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

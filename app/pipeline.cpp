@@ -160,11 +160,8 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
   dem::ModelSpec spec = s.spec;
   spec.domain = {Vec3(die_options.table->x_min, die_options.table->y_min, box.lo.z() - 1e-3),
                  Vec3(die_options.table->x_max, die_options.table->y_max, table_z + s.shoe_height + 5e-3)};
-  dem::MeshWall die_wall;
-  die_wall.field = die_field, die_wall.material = steel, die_wall.name = "die";
-  spec.meshes.push_back(die_wall);
-  dem::MeshWall shoe;
-  shoe.field = shoe_field, shoe.material = steel, shoe.name = "shoe";
+  spec.meshes.push_back(dem::fixed_mesh_wall(die_field, steel, "die"));
+  dem::MeshWall shoe = dem::fixed_mesh_wall(shoe_field, steel, "shoe");
   shoe.motion.start_position = plan.motion.start_position;
   shoe.passes_below_z = table_z + 0.5 * r_max;  // the grain on the rim edge then rides up (slope 30° > friction) or is cut
   spec.meshes.push_back(shoe);

@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dem/contact.hpp"
@@ -51,6 +52,15 @@ struct MeshWall {
   // cavity wall, where it can neither rise nor sink.
   double passes_below_z = -std::numeric_limits<double>::infinity();
 };
+
+// A wall at rest in the world frame.
+inline MeshWall fixed_mesh_wall(std::shared_ptr<const mesh::WallField> field, int material, std::string name) {
+  MeshWall wall;
+  wall.field = std::move(field);
+  wall.material = material;
+  wall.name = std::move(name);
+  return wall;
+}
 
 struct Box3 {
   Vec3 lo = Vec3::Constant(-1), hi = Vec3::Constant(1);

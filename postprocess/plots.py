@@ -1,7 +1,10 @@
 #!/usr/bin/python3
-"""Pictures of a fill density field, from the plot_data.json diefill writes beside it.
+"""Pictures diefill draws from the data it writes.
 
-    plots.py OUT_DIR   ->  OUT_DIR/top_view.png, section.png, histogram.png, profiles.png
+    plots.py density OUT_DIR  ->  OUT_DIR/top_view.png, section.png, histogram.png, profiles.png
+                                  (from OUT_DIR/plot_data.json)
+    plots.py clump NAME_errors.csv  ->  NAME_errors.png: a clump's errors and cost against its
+                                        sphere count
 
 Each picture has axes with units and, where colour carries a value, a colour bar.
 """
@@ -16,7 +19,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 
-def main(out_dir: Path) -> None:
+def density(out_dir: Path) -> None:
     data = json.loads((out_dir / "plot_data.json").read_text())
     h_mm = data["voxel_m"] * 1e3
     ox, oy, oz = (c * 1e3 for c in data["origin_m"])
@@ -80,5 +83,26 @@ def main(out_dir: Path) -> None:
     plt.close(fig)
 
 
+def clump(csv: Path) -> None:
+    data = np.genfromtxt(csv, delimiter=",", names=True)
+    data = np.atleast_1d(data)
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    ax.semilogy(data["spheres"], data["volume_error"], "o-", label="volume error")
+    ax.semilogy(data["spheres"], data["hausdorff_error"], "s-", label="Hausdorff error / equivalent diameter")
+    ax.set_xlabel("spheres per grain")
+    ax.set_ylabel("relative error [-]")
+    ax.grid(alpha=0.3, which="both")
+    cost = ax.twinx()
+    cost.plot(data["spheres"], data["relative_cost"], "k:", label="relative cost")
+    cost.set_ylabel("simulation cost relative to one sphere [-]")
+    lines = ax.get_legend_handles_labels()
+    more = cost.get_legend_handles_labels()
+    ax.legend(lines[0] + more[0], lines[1] + more[1], loc="upper center")
+    ax.set_title(f"Clump of {csv.stem.removesuffix('_errors')}")
+    fig.tight_layout()
+    fig.savefig(csv.with_suffix(".png"), dpi=120)
+    plt.close(fig)
+
+
 if __name__ == "__main__":
-    main(Path(sys.argv[1]))
+    {"density": density, "clump": clump}[sys.argv[1]](Path(sys.argv[2]))

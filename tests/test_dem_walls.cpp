@@ -38,7 +38,7 @@ std::pair<Vec3, int> settle_in_corner(bool mesh_wall) {
   const Vec3 g = 9.81 * Vec3(-1, 0, -1).normalized();
   dem::ModelSpec spec = test::spec_with({test::glass(0.3, 0.3), test::rigid_wall(0.3, 0.3)}, g);
   if (mesh_wall) {
-    spec.meshes.push_back({test::wall_field_of(corner_solid(), r / 4), 1, {}, "corner"});
+    spec.meshes.push_back(dem::fixed_mesh_wall(test::wall_field_of(corner_solid(), r / 4), 1, "corner"));
   } else {
     spec.planes.push_back({Vec3::Zero(), Vec3::UnitZ(), 1, "floor"});
     spec.planes.push_back({Vec3::Zero(), Vec3::UnitX(), 1, "wall"});
@@ -75,7 +75,7 @@ TEST(MeshWall, ConvexRimGivesOneContinuousContact) {
   const mesh::TriMesh ring = mesh::bundled_die("ring");
   const mesh::ToolMesh tool = mesh::tool_from_cavity(ring, mesh::table_around(ring, 5e-3), "ring");
   dem::ModelSpec spec = test::spec_with({test::glass(), test::rigid_wall()});
-  spec.meshes.push_back({test::wall_field_of(tool.mesh, r / 4), 1, {}, "ring"});
+  spec.meshes.push_back(dem::fixed_mesh_wall(test::wall_field_of(tool.mesh, r / 4), 1, "ring"));
   dem::State s;
   s.add_sphere(0, Vec3::Zero(), r, 2500, 0);
   const dem::Model model = dem::compile_model(spec, s, "rim");
@@ -118,7 +118,7 @@ TEST_P(PourIntoDie, TenThousandGrainsSettleWithoutLeaking) {
   spec.max_impact_speed = 0.6;
   spec.domain.lo = Vec3(-14e-3, -14e-3, -12e-3);
   spec.domain.hi = Vec3(14e-3, 14e-3, 20e-3);
-  spec.meshes.push_back({std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid)), 1, {}, name});
+  spec.meshes.push_back(dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid)), 1, name));
   dem::State s;
   dem::InsertRegion region;
   // A column over the opening (the annulus of the ring): grains landing on the table or the
@@ -184,7 +184,7 @@ TEST(MeshWall, PlateThinnerThanAVoxelStillBlocks) {
   const mesh::TriMesh plate = mesh::box_solid(Vec3(-5e-3, -5e-3, -0.125 * voxel), Vec3(5e-3, 5e-3, 0.125 * voxel));
   for (double side : {1.0, -1.0}) {
     dem::ModelSpec spec = test::spec_with({test::glass(0.5), test::rigid_wall(0.5)});
-    spec.meshes.push_back({test::wall_field_of(plate, voxel), 1, {}, "plate"});
+    spec.meshes.push_back(dem::fixed_mesh_wall(test::wall_field_of(plate, voxel), 1, "plate"));
     spec.max_impact_speed = 1.0;
     dem::State s;
     s.add_sphere(0, Vec3(0.3e-3, 0.2e-3, side * (r + 0.2e-3)), r, 2500, 0, Vec3(0, 0, -side * 1.0));

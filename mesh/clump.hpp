@@ -1,0 +1,71 @@
+#pragma once
+// Multi-sphere clump templates of irregular grains (STYLE.md §4: clumps are templates plus
+// instances). A template is built once per grain shape: the spheres, in the grain's principal
+// frame, plus the real grain's volume and principal moments, so that a simulation gives the
+// clump the mass and inertia of the grain rather than of the overlapping spheres.
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "mesh/trimesh.hpp"
+
+namespace mesh {
+
+// Volume, centroid and inertia of a solid of unit density bounded by a closed, outward mesh.
+struct MassProperties {
+  double volume = 0.0;                                            // [m³]
+  Vec3 centroid = Vec3::Zero();                                   // [m]
+  Eigen::Matrix3d inertia_per_density = Eigen::Matrix3d::Zero();  // about the centroid [m⁵]
+};
+
+// Exact polyhedral integrals (Eberly, "Polyhedral Mass Properties (Revisited)", 2002): no
+// sampling, exact up to rounding for any closed, outward triangle mesh.
+MassProperties mass_properties(const TriMesh& closed_outward_mesh);
+
+struct ClumpSphere {
+  Vec3 centre;    // [m], principal frame
+  double radius;  // [m]
+};
+
+// The errors after a given number of spheres: the curve from which a user picks a count.
+struct ClumpStep {
+  int spheres = 0;
+  double volume_error = 0.0;     // |V_union − V_mesh| / V_mesh
+  double hausdorff_error = 0.0;  // two-sided surface distance / equivalent diameter
+};
+
+struct ClumpTemplate {
+  // Principal frame: origin at the mesh centroid, axes the principal axes of inertia sorted by
+  // ascending moment; p_principal = rotation_mesh_to_principal · (p_mesh − mesh_centroid).
+  std::vector<ClumpSphere> spheres;
+  double mesh_volume_m3 = 0.0;
+  Vec3 inertia_principal_per_density = Vec3::Zero();  // ascending [m⁵]
+  Eigen::Matrix3d rotation_mesh_to_principal = Eigen::Matrix3d::Identity();
+  Vec3 mesh_centroid = Vec3::Zero();  // [m], mesh frame
+  double union_volume_m3 = 0.0;       // estimated on the sample grid
+  double volume_error = 0.0;
+  double hausdorff_error = 0.0;
+  double tolerance = 0.0;
+  double equivalent_diameter_m = 0.0;  // of the sphere with the grain's volume
+  std::vector<ClumpStep> history;      // one entry per sphere added
+};
+
+struct ClumpOptions {
+  double tolerance = 0.05;  // both relative errors must reach it
+  int max_spheres = 64;
+  std::uint64_t seed = 1;  // surface sampling; same seed and mesh give the same template
+  int samples = 150000;    // grid nodes over the grain's bounding box (at least 1000), for the
+                           // volume estimate
+};
+
+// Greedy sphere selection until the volume and Hausdorff errors both reach the tolerance.
+// Throws diefill::InputError for a mesh that is not closed and outward oriented (run repair
+// first), and when max_spheres spheres cannot reach the tolerance (the message says how far
+// they got).
+ClumpTemplate make_clump(const TriMesh& grain, const ClumpOptions& options);
+
+// The template as JSON (INTERFACE.md, "Clump template").
+std::string clump_json(const ClumpTemplate& clump);
+
+}  // namespace mesh
