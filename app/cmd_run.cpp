@@ -68,7 +68,14 @@ int run_pipeline(const RunCommand& c) {
   apply_command_line(scene, c);
   std::string csv = "die,status,grains_in_cavity,fill_ratio,solid_fraction_mean,solid_fraction_std,solid_fraction_min,solid_fraction_max,message\n";
   std::string md = "| die | status | grains in cavity | fill ratio | mean | std | min | max |\n|---|---|---|---|---|---|---|---|\n";
-  int failures = 0;
+  int refused = 0, unstable = 0;
+  const auto record_failure = [&](const fs::path& mesh, const char* status, std::string message) {
+    fmt::print(stderr, "error: {}\n", message);
+    std::replace(message.begin(), message.end(), ',', ';');
+    std::replace(message.begin(), message.end(), '|', '/');
+    csv += fmt::format("{},{},,,,,,,{}\n", mesh.stem().string(), status, message);
+    md += fmt::format("| {} | {}: {} | | | | | | |\n", mesh.stem().string(), status, message);
+  };
   for (const fs::path& mesh : meshes_in(c.target)) {
     try {
       const DieRun run = run_die_fill(scene, mesh, c.resume);
@@ -83,19 +90,17 @@ int run_pipeline(const RunCommand& c) {
                         value("solid_fraction_mean"), value("solid_fraction_std"), value("solid_fraction_min"),
                         value("solid_fraction_max"));
     } catch (const diefill::InputError& e) {
-      ++failures;
-      fmt::print(stderr, "error: {}\n", e.what());
-      std::string message = e.what();
-      std::replace(message.begin(), message.end(), ',', ';');
-      std::replace(message.begin(), message.end(), '|', '/');
-      csv += fmt::format("{},refused,,,,,,,{}\n", mesh.stem().string(), message);
-      md += fmt::format("| {} | refused: {} | | | | | | |\n", mesh.stem().string(), message);
+      ++refused;
+      record_failure(mesh, "refused", e.what());
+    } catch (const diefill::StabilityError& e) {
+      ++unstable;  // the next die may still run; its checkpoint stays for a resume
+      record_failure(mesh, "stopped", e.what());
     }
   }
   diefill::write_file_atomic(scene.out / "summary.csv", csv);
   diefill::write_file_atomic(scene.out / "summary.md", md);
   fmt::print("{}", md);
-  return failures > 0 ? diefill::exit_bad_input : 0;
+  return unstable > 0 ? diefill::exit_unstable : refused > 0 ? diefill::exit_bad_input : diefill::exit_ok;
 }
 
 }  // namespace app

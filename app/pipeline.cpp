@@ -158,6 +158,14 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
   auto die_field = std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid));
 
   dem::ModelSpec spec = s.spec;
+  // The collision time must resolve the fastest impact: a grain falling the die's depth onto the
+  // floor, plus the shoe's speed.
+  const double impact = std::sqrt(2 * spec.gravity.norm() * box.size().z()) + s.speed;
+  if (impact > spec.max_impact_speed) {
+    diefill::log::info("{}: impacts reach {:.3g} m/s in this die; time step set for them (simulation.max_impact_speed was {:.3g})",
+                       die.name, impact, spec.max_impact_speed);
+    spec.max_impact_speed = impact;
+  }
   spec.domain = {Vec3(die_options.table->x_min, die_options.table->y_min, box.lo.z() - 1e-3),
                  Vec3(die_options.table->x_max, die_options.table->y_max, table_z + s.shoe_height + 5e-3)};
   spec.meshes.push_back(dem::fixed_mesh_wall(die_field, steel, "die"));
@@ -170,8 +178,8 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
   //    shapes it, and always resumed from the cached positions so that a cached and a fresh run
   //    give the same result.
   const std::string shoe_key = diefill::sha256_hex(fmt::format(
-      "v2;{};{};{:a};{:a};{:a};{:a};{:a};{:a};{:a};{:a};{};{}", die.cache_key, describe(settling_part(s)), diameter, plan.length,
-      plan.width, plan.x_start, plan.y_centre, s.fill_height, s.shoe_settle_time, table_z, s.seed, powder));
+      "v2;{};{};{:a};{:a};{:a};{:a};{:a};{:a};{:a};{:a};{};{};{:a}", die.cache_key, describe(settling_part(s)), diameter, plan.length,
+      plan.width, plan.x_start, plan.y_centre, s.fill_height, s.shoe_settle_time, table_z, s.seed, powder, spec.max_impact_speed));
   const fs::path settled = cache / ("shoe-" + shoe_key + ".csv");
   const double density = spec.materials[std::size_t(powder)].density;
   if (!fs::exists(settled)) {

@@ -208,7 +208,7 @@ std::string describe(const PipelineScene& s) {
   out += s.spec.time_step ? fmt::format("time_step = {}\n", *s.spec.time_step)
                           : "time_step = \"auto\"         # a fraction of the Rayleigh and Hertz collision times\n";
   out += fmt::format("time_step_fraction = {}\n", s.spec.time_step_fraction);
-  out += fmt::format("max_impact_speed = {}       # [m/s] for the collision time: the fall into the die plus the shoe\n", s.spec.max_impact_speed);
+  out += fmt::format("max_impact_speed = {}       # [m/s] for the collision time; raised to sqrt(2 g depth) + shoe speed for deeper dies\n", s.spec.max_impact_speed);
   out += fmt::format("gravity = [{}, {}, {}]\n", s.spec.gravity.x(), s.spec.gravity.y(), s.spec.gravity.z());
   if (s.spec.skin) out += fmt::format("skin = {}\n", *s.spec.skin);
   out += fmt::format("seed = {}\n", s.seed);
