@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "app/clump_stage.hpp"
 #include "app/density_stage.hpp"
 #include "app/run_loop.hpp"
 #include "core/atomic_file.hpp"
@@ -78,6 +79,39 @@ ShoePlan plan_shoe(const PipelineScene& s, const mesh::Box& die_box, double tabl
   return p;
 }
 
+// A grain once: a free sphere, or a clump by its centre of mass.
+struct GrainRef {
+  Vec3 centre;
+  bool active;
+  std::int64_t body;  // -1: the free sphere `index`
+  std::size_t index;
+};
+
+std::vector<GrainRef> grains_of(const dem::State& s) {
+  std::vector<GrainRef> grains;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (s.body[i] < 0) grains.push_back({s.x[i], s.active[i] != 0, -1, i});
+  for (std::size_t b = 0; b < s.bodies.size(); ++b) grains.push_back({s.bodies.x[b], s.bodies.active[b] != 0, std::int64_t(b), b});
+  return grains;
+}
+
+// The grain's volume as spheres for binning: a clump's members weighted so that they add up to
+// the real grain's volume, counted once however much they overlap.
+void add_volume(const dem::State& s, const GrainRef& g, std::vector<post::Grain>& out) {
+  if (g.body < 0) {
+    out.push_back({s.x[g.index], s.radius[g.index], 1.0});
+    return;
+  }
+  const dem::Bodies& b = s.bodies;
+  const auto first = std::size_t(b.member_start[g.index]), last = std::size_t(b.member_start[g.index + 1]);
+  double members = 0;
+  for (std::size_t m = first; m < last; ++m) members += 4.0 / 3.0 * std::numbers::pi * std::pow(s.radius[std::size_t(b.member[m])], 3);
+  for (std::size_t m = first; m < last; ++m) {
+    const std::size_t i = std::size_t(b.member[m]);
+    out.push_back({s.x[i], s.radius[i], b.volume[g.index] / members});
+  }
+}
+
 // The scene less what happens after the shoe has settled (its motion, the die's settling, the
 // density field, the output): the key of the cached settled shoe.
 PipelineScene settling_part(const PipelineScene& s) {
@@ -97,9 +131,6 @@ PipelineScene settling_part(const PipelineScene& s) {
 DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resume) {
   diefill::Stopwatch wall_clock;
   if (s.threads > 0) omp_set_num_threads(s.threads);
-  if (!s.shape_mesh.empty())
-    throw InputError(s.source, "powder.shape", "multi-sphere grains are not simulated yet; the run would use spheres",
-                     "Remove powder.shape to fill the die with spheres");
   const int powder = material_named(s.spec, "powder"), steel = material_named(s.spec, "steel");
   double diameter = s.grain_diameter();
   const double spread = s.diameter_spread;
@@ -178,11 +209,17 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
   //    shapes it, and always resumed from the cached positions so that a cached and a fresh run
   //    give the same result.
   const std::string shoe_key = diefill::sha256_hex(fmt::format(
-      "v2;{};{};{:a};{:a};{:a};{:a};{:a};{:a};{:a};{:a};{};{};{:a}", die.cache_key, describe(settling_part(s)), diameter, plan.length,
-      plan.width, plan.x_start, plan.y_centre, s.fill_height, s.shoe_settle_time, table_z, s.seed, powder, spec.max_impact_speed));
+      "v2;{};{};{:a};{:a};{:a};{:a};{:a};{:a};{:a};{:a};{};{}", die.cache_key, describe(settling_part(s)), diameter, plan.length,
+      plan.width, plan.x_start, plan.y_centre, s.fill_height, s.shoe_settle_time, table_z, s.seed, powder));
   const fs::path settled = cache / ("shoe-" + shoe_key + ".csv");
   const double density = spec.materials[std::size_t(powder)].density;
-  if (!fs::exists(settled)) {
+  const bool clumps = !s.shape_mesh.empty();
+  std::optional<mesh::ClumpTemplate> shape;
+  if (clumps)
+    shape = build_clump({s.shape_mesh, mesh::parse_unit(s.shape_units, "powder.shape.units"), s.shape_tolerance, 64, s.seed});
+  dem::State state;
+  // Clumps are settled afresh each run: the particles file does not hold their poses.
+  if (clumps || !fs::exists(settled)) {
     dem::State fill;
     dem::InsertRegion region;
     const double inset = r_max + 1e-6;
@@ -197,21 +234,35 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
     request.density = density;
     request.seed = s.seed;
     request.max_solid_fraction = 0.45;
-    const std::size_t inserted = dem::insert_spheres(fill, region, request);
-    diefill::log::info("{}: settling {} grains of {:.3g} mm in the shoe ({:.3g} x {:.3g} mm, once; cached)", die.name,
-                       inserted, diameter * 1e3, plan.length * 1e3, plan.width * 1e3);
-    const dem::Model settle_model = dem::compile_model(spec, fill, s.source);
+    const std::size_t inserted =
+        clumps ? dem::insert_clumps(fill, region, *shape, diameter / shape->equivalent_diameter_m, request.count, powder,
+                                    density, s.seed)
+               : dem::insert_spheres(fill, region, request);
+    diefill::log::info("{}: settling {} {} of {:.3g} mm in the shoe ({:.3g} x {:.3g} mm{})", die.name, inserted,
+                       clumps ? fmt::format("clumps of {} spheres", shape->spheres.size()) : "grains", diameter * 1e3,
+                       plan.length * 1e3, plan.width * 1e3, clumps ? "" : ", once; cached");
+    // The settling shoe sees no fall into the die: the scene's time step, whatever the die and
+    // the shoe's speed, so that runs differing in those reuse it.
+    dem::ModelSpec settle_spec = spec;
+    settle_spec.max_impact_speed = s.spec.max_impact_speed;
+    const dem::Model settle_model = dem::compile_model(settle_spec, fill, s.source);
     dem::initialize(settle_model, fill);
     LoopOptions loop;
     loop.until = s.shoe_settle_time;
     loop.label = die.name + ": settling the shoe";
     run_until(settle_model, fill, loop);
-    dem::write_particles_csv(fill, settled);
+    if (clumps) state = std::move(fill);
+    else dem::write_particles_csv(fill, settled);
   }
-  dem::State state = dem::read_particles_csv(settled, powder, density);
+  // A cached and a fresh run start from the same numbers: the file's.
+  if (!clumps) state = dem::read_particles_csv(settled, powder, density);
   for (Vec3& v : state.v) v.setZero();
   for (Vec3& w : state.w) w.setZero();
-  const std::size_t inserted = state.size();
+  for (Vec3& v : state.bodies.v) v.setZero();
+  for (Vec3& l : state.bodies.l) l.setZero();
+  state.time = 0;  // the shoe's motion starts now
+  state.step = 0;
+  const std::size_t inserted = grains_of(state).size();
 
   // 4. Move the shoe, then let the die settle.
   spec.meshes[1].motion = plan.motion;
@@ -225,7 +276,7 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
   }
   auto in_cavity = [&](const dem::State& st) {
     std::size_t n = 0;
-    for (std::size_t i = 0; i < st.size(); ++i) n += st.active[i] && st.x[i].z() < table_z;
+    for (const GrainRef& g : grains_of(st)) n += g.active && g.centre.z() < table_z;
     return n;
   };
   LoopOptions loop;
@@ -251,22 +302,26 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
   // 5. Count every grain.
   const Vec3 shoe_centre = plan.motion.position(state.time);
   std::size_t cavity = 0, in_shoe = 0, elsewhere = 0;
+  std::size_t lost = 0;
   std::vector<post::Grain> grains;
-  for (std::size_t i = 0; i < state.size(); ++i) {
-    if (!state.active[i]) continue;
-    const Vec3& x = state.x[i];
+  for (const GrainRef& g : grains_of(state)) {
+    if (!g.active) {
+      ++lost;
+      continue;
+    }
+    const Vec3& x = g.centre;
     if (x.z() < table_z) {
       ++cavity;
-      grains.push_back({x, state.radius[i], 1.0});
+      add_volume(state, g, grains);
     } else if (std::abs(x.x() - shoe_centre.x()) < 0.5 * plan.length && std::abs(x.y() - shoe_centre.y()) < 0.5 * plan.width) {
       ++in_shoe;
     } else {
       ++elsewhere;
     }
   }
-  if (state.lost > 0)
+  if (lost > 0)
     throw InputError(die_mesh.string(), "particles.lost",
-                     fmt::format("{} grains left the simulated domain (through the walls or over the table's edge)", state.lost),
+                     fmt::format("{} grains left the simulated domain (through the walls or over the table's edge)", lost),
                      "Check the die mesh for holes, or lower the shoe speed");
 
   // 6. Density, report, pictures: staged, so that a failure keeps the earlier outputs.
@@ -293,7 +348,11 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
   dem::write_vtu(state, out / "final.vtu");
   diefill::write_file_atomic(out / "scene.toml", describe(s));
   double grain_volume_total = 0;
-  for (std::size_t i = 0; i < state.size(); ++i) grain_volume_total += 4.0 / 3.0 * std::numbers::pi * std::pow(state.radius[i], 3);
+  {
+    std::vector<post::Grain> all;
+    for (const GrainRef& g : grains_of(state)) add_volume(state, g, all);
+    for (const post::Grain& g : all) grain_volume_total += g.weight * 4.0 / 3.0 * std::numbers::pi * std::pow(g.radius, 3);
+  }
   const double steps = double(result.steps);
   nlohmann::json report = {
       {"die",
@@ -311,15 +370,16 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
         {"material_density", density},
         {"coarse_graining", diameter / s.particle_diameter},
         {"grain_diameter_m", diameter},
-        {"shape", "sphere"}}},
+        {"shape", clumps ? s.shape_mesh : "sphere"},
+        {"spheres_per_grain", clumps ? shape->spheres.size() : std::size_t{1}}}},
       {"shoe", {{"length_m", plan.length}, {"width_m", plan.width}, {"speed_m_s", s.speed}, {"passes", s.passes}}},
       {"fill", fill_json},
-      {"particles", {{"inserted", inserted}, {"in_cavity", cavity}, {"in_shoe", in_shoe}, {"elsewhere", elsewhere}, {"lost", state.lost}}},
+      {"particles", {{"inserted", inserted}, {"in_cavity", cavity}, {"in_shoe", in_shoe}, {"elsewhere", elsewhere}, {"lost", lost}}},
       {"timing",
        {{"wall_s", wall_clock.seconds()},
         {"steps", result.steps},
         {"dt_s", model.dt},
-        {"particle_steps_per_s", steps * double(inserted) / std::max(1e-9, result.wall_s)},
+        {"particle_steps_per_s", steps * double(state.size()) / std::max(1e-9, result.wall_s)},
         {"stages",
          {{"neighbours", result.times.neighbours},
           {"pair_forces", result.times.pair_forces},

@@ -92,6 +92,7 @@ PipelineScene load_pipeline_scene(const std::optional<std::filesystem::path>& sc
     if (auto shape = t->table("shape")) {
       if (auto m = shape->string("mesh")) s.shape_mesh = (base / *m).string();
       s.shape_tolerance = shape->number("tolerance", s.shape_tolerance);
+      if (auto u = shape->string("units")) s.shape_units = *u;
       shape->finish();
     }
     if (!(s.particle_diameter > 0)) t->fail("particle_diameter", "must be positive [m]", "Give the powder's diameter");
@@ -175,7 +176,7 @@ std::string describe(const PipelineScene& s) {
   out += fmt::format("coarse_graining = {}       # α: grains {} mm across; Hertz forces keep bulk behaviour (PHYSICS.md §4)\n", s.coarse_graining, s.grain_diameter() * 1e3);
   out += fmt::format("diameter_spread = {}       # ±10 % sizes keep the packing random, not crystalline\n", s.diameter_spread);
   out += fmt::format("max_grains = {}         # larger α when the powder would need more grains\n", s.max_grains);
-  if (!s.shape_mesh.empty()) out += fmt::format("shape = {{ mesh = \"{}\", tolerance = {} }}\n", s.shape_mesh, s.shape_tolerance);
+  if (!s.shape_mesh.empty()) out += fmt::format("shape = {{ mesh = \"{}\", tolerance = {}, units = \"{}\" }}  # rigid clumps scaled to the grain diameter (volume-equivalent)\n", s.shape_mesh, s.shape_tolerance, s.shape_units);
   out += "\n[contact]\n";
   out += fmt::format("normal = \"{}\"\n", law(s.spec.normal, {"hertz", "linear"}));
   out += fmt::format("tangential = \"{}\"\n", law(s.spec.tangential, {"mindlin", "none"}));

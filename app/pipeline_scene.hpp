@@ -38,6 +38,7 @@ struct PipelineScene {
   std::size_t max_grains = 60000;     // coarser grains (larger α) beyond this, with a warning
   std::string shape_mesh;             // clumps (issue 6): a grain surface mesh
   double shape_tolerance = 0.05;
+  std::string shape_units = "mm";
   // [materials], [contact], [simulation]
   dem::ModelSpec spec;                // materials "powder", "steel"; laws; gravity; time step
   std::uint64_t seed = 1;

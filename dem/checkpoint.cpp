@@ -9,7 +9,7 @@ namespace dem {
 
 namespace {
 
-constexpr char magic[8] = {'D', 'F', 'C', 'K', 'P', 'T', '0', '1'};
+constexpr char magic[8] = {'D', 'F', 'C', 'K', 'P', 'T', '0', '2'};
 
 struct Writer {
   std::string bytes;
@@ -53,7 +53,22 @@ void fields(IO& io, S& s) {
   io.array(s.inertia);
   io.array(s.material);
   io.array(s.active);
+  io.array(s.body);
   io.array(s.wall_slots);
+  auto& b = s.bodies;
+  io.array(b.x);
+  io.array(b.v);
+  io.array(b.q);
+  io.array(b.l);
+  io.array(b.f);
+  io.array(b.torque);
+  io.array(b.mass);
+  io.array(b.inertia);
+  io.array(b.volume);
+  io.array(b.active);
+  io.array(b.member_start);
+  io.array(b.member);
+  io.array(b.offset);
   auto& nl = s.neighbours;
   io.array(nl.row_start);
   io.array(nl.partner);

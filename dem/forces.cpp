@@ -27,7 +27,8 @@ void pair_forces(const Model& model, State& s) {
     const Vec3 xi = s.x[i], vi = s.v[i], wi = s.w[i];
     const double ri = s.radius[i], mi = s.mass[i];
     const int mat_i = s.material[i];
-    Vec3 fi = mi * model.gravity, ti = Vec3::Zero();
+    // A clump's weight acts at its centre of mass, which its members' centres need not share.
+    Vec3 fi = s.body[i] < 0 ? Vec3(mi * model.gravity) : Vec3::Zero(), ti = Vec3::Zero();
     for (std::int32_t p = first; p < last; ++p) {
       const std::size_t j = std::size_t(nl.partner[std::size_t(p)]);
       const Vec3 d = xi - s.x[j];

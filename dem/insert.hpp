@@ -1,6 +1,7 @@
 #pragma once
-// Insertion: a loose random packing of spheres (random sequential addition without overlaps)
-// in a box, optionally restricted to the inside of a closed surface, reproducible from a seed.
+// Insertion: a loose random packing of spheres or clumps (random sequential addition without
+// overlaps) in a box, optionally restricted to the inside of a closed surface, reproducible from
+// a seed.
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -8,6 +9,7 @@
 
 #include "dem/model.hpp"
 #include "dem/state.hpp"
+#include "mesh/clump.hpp"
 
 namespace dem {
 
@@ -36,6 +38,14 @@ struct InsertRequest {
 
 // Returns how many spheres were added; fewer than asked when the region is full.
 std::size_t insert_spheres(State& state, const InsertRegion& region, const InsertRequest& request);
+
+// Clumps of `clump` scaled by `scale`, centres drawn in region.box, uniformly random
+// orientations, no overlap with each other or the grains present (their bounding spheres are
+// tested, against the region too); members get ids from first_id on. Returns how many were
+// added: fewer than `count` when the region is full.
+std::size_t insert_clumps(State& state, const InsertRegion& region, const mesh::ClumpTemplate& clump, double scale,
+                          std::size_t count, int material, double density, std::uint64_t seed,
+                          std::int64_t first_id = 0);
 
 // A small deterministic generator (SplitMix64): the same numbers on every platform.
 class Random {

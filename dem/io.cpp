@@ -50,6 +50,7 @@ State read_particles_csv(const fs::path& path, int material, double default_dens
       throw InputError(path.string(), std::string("column ") + name, "is missing from the header",
                        "The header must name id,x,y,z,vx,vy,vz,wx,wy,wz,radius (density optional)");
   const bool has_density = column.count("density") > 0;
+  const bool has_body = column.count("body") > 0;
   State s;
   std::string line;
   for (std::size_t number = 2; std::getline(in, line); ++number) {
@@ -67,6 +68,12 @@ State read_particles_csv(const fs::path& path, int material, double default_dens
                          fmt::format("'{}' is not a finite number", cells[c]), "Correct the value");
       return v;
     };
+    // A member's place in its clump (the template's offsets, the grain's mass and inertia) is
+    // not in the file: refuse rather than read the clump as loose spheres.
+    if (has_body && value("body") >= 0)
+      throw InputError(path.string(), fmt::format("line {}, column body", number),
+                       "names a clump member; clumps cannot be read from a particles CSV",
+                       "Resume a clump run from its checkpoint, or insert the clumps from their template");
     const double id = value("id");
     const Vec3 x(value("x"), value("y"), value("z")), v(value("vx"), value("vy"), value("vz")),
         w(value("wx"), value("wy"), value("wz"));
@@ -86,12 +93,22 @@ State read_particles_csv(const fs::path& path, int material, double default_dens
 }
 
 void write_particles_csv(const State& s, const fs::path& path) {
-  std::string out = "id,x,y,z,vx,vy,vz,wx,wy,wz,radius,density\n";
+  const bool clumps = s.bodies.size() > 0;
+  std::string out = clumps ? "id,x,y,z,vx,vy,vz,wx,wy,wz,radius,density,body,qw,qx,qy,qz\n"
+                           : "id,x,y,z,vx,vy,vz,wx,wy,wz,radius,density\n";
   for (std::size_t i = 0; i < s.size(); ++i) {
-    const double density = s.mass[i] / (4.0 / 3.0 * 3.14159265358979323846 * std::pow(s.radius[i], 3));
-    out += fmt::format("{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}\n",
+    const std::int32_t b = s.body[i];
+    // A member's density is its grain's, whose mass is the body's.
+    const double density = b >= 0 ? s.bodies.mass[std::size_t(b)] / s.bodies.volume[std::size_t(b)]
+                                   : s.mass[i] / (4.0 / 3.0 * 3.14159265358979323846 * std::pow(s.radius[i], 3));
+    out += fmt::format("{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}",
                        s.id[i], s.x[i].x(), s.x[i].y(), s.x[i].z(), s.v[i].x(), s.v[i].y(), s.v[i].z(), s.w[i].x(),
                        s.w[i].y(), s.w[i].z(), s.radius[i], density);
+    if (clumps) {
+      const Quat q = b >= 0 ? s.bodies.q[std::size_t(b)] : Quat::Identity();
+      out += fmt::format(",{},{:.17g},{:.17g},{:.17g},{:.17g}", b, q.w(), q.x(), q.y(), q.z());
+    }
+    out += '\n';
   }
   diefill::write_file_atomic(path, out);
 }
@@ -135,7 +152,12 @@ void write_vtu(const State& s, const fs::path& path) {
   vectors("angular_velocity", s.w);
   vectors("force", s.f);
   out += "<DataArray type=\"Int64\" Name=\"body\" format=\"ascii\">\n";
-  for (auto id : s.id) out += fmt::format("{}\n", id);  // a sphere is its own body
+  // A sphere is its own body; a clump is named by its first member.
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const std::int32_t b = s.body[i];
+    const std::size_t named = b < 0 ? i : std::size_t(s.bodies.member[std::size_t(s.bodies.member_start[std::size_t(b)])]);
+    out += fmt::format("{}\n", s.id[named]);
+  }
   out += "</DataArray>\n</PointData>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
   for (std::size_t i = 0; i < s.size(); ++i) out += fmt::format("{}\n", i);
   out += "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";

@@ -11,10 +11,12 @@
 namespace dem {
 
 // Reads `id,x,y,z,vx,vy,vz,wx,wy,wz,radius[,density]` (header required, columns in any order;
-// body,qw,qx,qy,qz are accepted and ignored for spheres). Grains get `material`, and
+// body,qw,qx,qy,qz are accepted and ignored for free spheres, body -1; a clump member throws). Grains get `material`, and
 // `default_density` when the file has no density column. Throws InputError naming the file,
 // the line and the column for missing columns, unparsable or non-finite values.
 State read_particles_csv(const std::filesystem::path& path, int material, double default_density);
+// Adds `body,qw,qx,qy,qz` (body index, its orientation; -1 and identity for a free sphere)
+// when the state holds clumps.
 void write_particles_csv(const State& state, const std::filesystem::path& path);
 
 // Appends `t,id,x,y,z,vx,vy,vz,wx,wy,wz,fx,fy,fz` rows.

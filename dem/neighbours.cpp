@@ -83,6 +83,8 @@ void sort_particles(State& s, const CellGrid& g, std::vector<std::int32_t>& new_
   permute(s.inertia, order);
   permute(s.material, order);
   permute(s.active, order);
+  permute(s.body, order);
+  for (std::int32_t& i : s.bodies.member) i = new_index[std::size_t(i)];
   std::vector<WallSlot> slots(s.wall_slots.size());
   for (std::size_t n = 0; n < order.size(); ++n)
     for (int k = 0; k < wall_slots_per_particle; ++k)
@@ -114,13 +116,24 @@ bool needs_rebuild(const Model& model, const State& s) {
 }
 
 void rebuild_neighbours(const Model& model, State& s) {
-  // Particles outside the domain are lost: counted, frozen, never silently dropped.
+  // Particles outside the domain are lost: counted, frozen, never silently dropped. A clump is
+  // lost whole, when its centre leaves.
+  auto lose = [&s](std::size_t i) {
+    s.active[i] = 0;
+    s.v[i].setZero();
+    s.w[i].setZero();
+    ++s.lost;
+  };
   for (std::size_t i = 0; i < s.size(); ++i)
-    if (s.active[i] && !model.domain.contains(s.x[i])) {
-      s.active[i] = 0;
-      s.v[i].setZero();
-      s.w[i].setZero();
-      ++s.lost;
+    if (s.active[i] && s.body[i] < 0 && !model.domain.contains(s.x[i])) lose(i);
+  Bodies& bodies = s.bodies;
+  for (std::size_t b = 0; b < bodies.size(); ++b)
+    if (bodies.active[b] && !model.domain.contains(bodies.x[b])) {
+      bodies.active[b] = 0;
+      bodies.v[b].setZero();
+      bodies.l[b].setZero();
+      for (std::int32_t k = bodies.member_start[b]; k < bodies.member_start[b + 1]; ++k)
+        lose(std::size_t(bodies.member[std::size_t(k)]));
     }
 
   // Old pairs with their history, by particle index before sorting.
@@ -157,6 +170,7 @@ void rebuild_neighbours(const Model& model, State& s) {
   for (std::size_t i = 0; i < n; ++i) {
     if (!s.active[i]) continue;
     const Vec3& xi = s.x[i];
+    const std::int32_t body = s.body[i];
     const int cx = grid.cell_coord(xi.x(), 0), cy = grid.cell_coord(xi.y(), 1), cz = grid.cell_coord(xi.z(), 2);
     std::vector<std::int32_t>& row = rows[i];
     for (int a = std::max(0, cx - 1); a <= std::min(grid.dims[0] - 1, cx + 1); ++a)
@@ -165,7 +179,8 @@ void rebuild_neighbours(const Model& model, State& s) {
           const std::size_t cell = (std::size_t(a) * std::size_t(grid.dims[1]) + std::size_t(b)) * std::size_t(grid.dims[2]) + std::size_t(c);
           for (std::int32_t m = grid.start[cell]; m < grid.start[cell + 1]; ++m) {
             const std::int32_t j = grid.members[std::size_t(m)];
-            if (j <= std::int32_t(i)) continue;
+            // Members of one clump never touch: the clump is rigid.
+            if (j <= std::int32_t(i) || (body >= 0 && s.body[std::size_t(j)] == body)) continue;
             const double reach = s.radius[i] + s.radius[std::size_t(j)] + model.skin;
             if ((s.x[std::size_t(j)] - xi).squaredNorm() < reach * reach) row.push_back(j);
           }

@@ -18,6 +18,7 @@ void State::add_sphere(std::int64_t particle_id, const Vec3& position, double r,
   inertia.push_back(0.4 * m * r * r);
   material.push_back(material_index);
   active.push_back(1);
+  body.push_back(-1);
   wall_slots.resize(wall_slots.size() + wall_slots_per_particle);
 }
 

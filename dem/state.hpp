@@ -2,7 +2,8 @@
 // Everything that changes while stepping. Particles are a structure of arrays; the neighbour
 // list is a half list (j > i) in compressed rows, with each pair's contact history beside it
 // and per-pair force buffers, so that per-particle sums run in a fixed order whatever the
-// thread count (bit-identical results). Shapes: N particles, P listed pairs, K wall slots.
+// thread count (bit-identical results). Shapes: N particles, P listed pairs, K wall slots,
+// B rigid bodies (clumps) with M members in all.
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -49,6 +50,33 @@ struct PairForces {
   std::vector<Vec3> torque;  // [P] on j [N m]
 };
 
+// Rigid multi-sphere clumps. Members are ordinary particles, so that contacts between clumps,
+// their histories and wall contacts need no code of their own; the body owns the motion: its
+// members are never integrated as free spheres but placed from the pose after each update. A
+// body lists its members in template order (particles are re-sorted at every neighbour
+// rebuild, so `member` is remapped then), and its force and torque are summed in that order:
+// the same bits for any thread count. Angular momentum is kept in the world frame, where a free
+// body's stays constant exactly; mass and inertia are the grain's, not the spheres'.
+struct Bodies {
+  std::vector<Vec3> x;              // [B] centre of mass [m]
+  std::vector<Vec3> v;              // [B] [m/s]
+  std::vector<Quat> q;              // [B] unit, principal frame to world
+  std::vector<Vec3> l;              // [B] angular momentum about the centre, world frame [kg m²/s]
+  std::vector<Vec3> f;              // [B] [N], gravity included
+  std::vector<Vec3> torque;         // [B] about the centre, world frame [N m]
+  std::vector<double> mass;         // [B] [kg]
+  std::vector<Vec3> inertia;        // [B] principal moments, ascending [kg m²]
+  std::vector<double> volume;       // [B] of the grain (not of the spheres' union) [m³]
+  std::vector<std::uint8_t> active; // [B] 0: lost with its members
+  std::vector<std::int32_t> member_start;  // [B+1] members of b: [member_start[b], member_start[b+1])
+  std::vector<std::int32_t> member;        // [M] particle index
+  std::vector<Vec3> offset;                // [M] member centre in the principal frame [m]
+
+  std::size_t size() const { return x.size(); }
+  // World angular velocity ω = R I⁻¹ Rᵀ L [rad/s].
+  Vec3 angular_velocity(std::size_t b) const { return q[b] * (q[b].conjugate() * l[b]).cwiseQuotient(inertia[b]); }
+};
+
 struct StepCounters {
   double max_overlap_rel = 0;   // largest δ/R this step
   std::int64_t contacts = 0;    // pair contacts this step
@@ -65,11 +93,14 @@ struct State {
   std::vector<Vec3> f;          // force [N]
   std::vector<Vec3> torque;     // [N m]
   std::vector<double> radius;   // [m]
-  std::vector<double> mass;     // [kg]
-  std::vector<double> inertia;  // [kg m²] (solid sphere: 2/5 m r²)
+  std::vector<double> mass;     // [kg]; a clump member's is its body's, for the contact laws
+  std::vector<double> inertia;  // [kg m²] (solid sphere: 2/5 m r²); unused for clump members
   std::vector<std::int32_t> material;
   std::vector<std::uint8_t> active;  // 0: lost (left the domain), no longer simulated
+  std::vector<std::int32_t> body;    // index into `bodies`; -1: a free sphere
   std::vector<WallSlot> wall_slots;  // [N*K]
+
+  Bodies bodies;
 
   NeighbourList neighbours;
   PairForces pair_forces;

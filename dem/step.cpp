@@ -6,6 +6,7 @@
 
 #include "core/sha256.hpp"
 #include "core/timer.hpp"
+#include "dem/bodies.hpp"
 #include "dem/forces.hpp"
 #include "dem/neighbours.hpp"
 #include "dem/walls.hpp"
@@ -14,21 +15,24 @@ namespace dem {
 
 namespace {
 
+// Clump members move with their bodies, which move last.
 void kick(State& s, double half_dt) {
   const std::size_t n = s.size();
 #pragma omp parallel for schedule(static)
   for (std::size_t i = 0; i < n; ++i) {
-    if (!s.active[i]) continue;
+    if (!s.active[i] || s.body[i] >= 0) continue;
     s.v[i] += (half_dt / s.mass[i]) * s.f[i];
     s.w[i] += (half_dt / s.inertia[i]) * s.torque[i];
   }
+  kick_bodies(s, half_dt);
 }
 
 void drift(State& s, double dt) {
   const std::size_t n = s.size();
 #pragma omp parallel for schedule(static)
   for (std::size_t i = 0; i < n; ++i)
-    if (s.active[i]) s.x[i] += dt * s.v[i];
+    if (s.active[i] && s.body[i] < 0) s.x[i] += dt * s.v[i];
+  drift_bodies(s, dt);
 }
 
 void forces(const Model& model, State& s, StageTimes* times) {
@@ -38,7 +42,9 @@ void forces(const Model& model, State& s, StageTimes* times) {
   sum_forces(model, s);
   if (times) times->sums += clock.seconds(), clock.restart();
   compute_wall_forces(model, s);
-  if (times) times->wall_forces += clock.seconds();
+  if (times) times->wall_forces += clock.seconds(), clock.restart();
+  sum_body_forces(model, s);
+  if (times) times->sums += clock.seconds();
 }
 
 // Which contact overlaps most, for the stop message: a serial scan, run once when stopping.
@@ -114,18 +120,19 @@ StepReport monitor(const Model& model, State& s) {
 
 }  // namespace
 
+// Clump members carry their body's motion: their energy is the body's, counted once.
 double kinetic_energy(const State& s) {
   double e = 0;
   for (std::size_t i = 0; i < s.size(); ++i)
-    if (s.active[i]) e += 0.5 * s.mass[i] * s.v[i].squaredNorm() + 0.5 * s.inertia[i] * s.w[i].squaredNorm();
-  return e;
+    if (s.active[i] && s.body[i] < 0) e += 0.5 * s.mass[i] * s.v[i].squaredNorm() + 0.5 * s.inertia[i] * s.w[i].squaredNorm();
+  return e + body_kinetic_energy(s);
 }
 
 double potential_energy(const Model& model, const State& s) {
   double e = 0;
   for (std::size_t i = 0; i < s.size(); ++i)
-    if (s.active[i]) e -= s.mass[i] * model.gravity.dot(s.x[i]);
-  return e;
+    if (s.active[i] && s.body[i] < 0) e -= s.mass[i] * model.gravity.dot(s.x[i]);
+  return e + body_potential_energy(model, s);
 }
 
 void initialize(const Model& model, State& s) {
@@ -137,7 +144,11 @@ void initialize(const Model& model, State& s) {
   s.energy_reference = kinetic_energy(s) + potential_energy(model, s) + elastic_energy(model, s);
   s.energy_scale = 0;
   for (std::size_t i = 0; i < s.size(); ++i)
-    s.energy_scale += s.mass[i] * model.gravity.norm() * s.radius[i];
+    if (s.body[i] < 0) s.energy_scale += s.mass[i] * model.gravity.norm() * s.radius[i];
+  for (std::size_t b = 0; b < s.bodies.size(); ++b)
+    for (std::int32_t k = s.bodies.member_start[b]; k < s.bodies.member_start[b + 1]; ++k)
+      s.energy_scale += s.bodies.mass[b] * model.gravity.norm() * s.radius[std::size_t(s.bodies.member[std::size_t(k)])] /
+                        double(s.bodies.member_start[b + 1] - s.bodies.member_start[b]);
   s.energy_reference_set = true;
 }
 
@@ -168,6 +179,16 @@ std::string state_hash(const State& s) {
   put(s.w);
   put(s.active);
   put(s.neighbours.history);
+  // Bodies only where there are any, so that a sphere scene hashes as it always did.
+  if (s.bodies.size() > 0) {
+    put(s.body);
+    put(s.bodies.x);
+    put(s.bodies.v);
+    put(s.bodies.q);
+    put(s.bodies.l);
+    put(s.bodies.active);
+    put(s.bodies.member);
+  }
   for (const WallSlot& w : s.wall_slots) {
     h.update(&w.wall, sizeof w.wall);
     h.update(w.history.tangential.data(), sizeof(double) * 3);

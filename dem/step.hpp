@@ -1,8 +1,9 @@
 #pragma once
 // One time step, as a table of contents of its stages (each timed):
 //   kick (half) -> drift -> neighbour update (when needed) -> grain-grain forces -> sums ->
-//   grain-wall forces -> kick (half) -> monitor
-// Velocity Verlet: second order and symplectic for conservative forces.
+//   grain-wall forces -> body sums (clumps) -> kick (half) -> monitor
+// Velocity Verlet: second order and symplectic for conservative forces; clumps rotate by the
+// splitting in bodies.hpp.
 #include <string>
 
 #include "dem/model.hpp"
@@ -31,7 +32,7 @@ StepReport step(const Model& model, State& state, StageTimes* times = nullptr);
 double kinetic_energy(const State& state);
 double potential_energy(const Model& model, const State& state);
 
-// A hash of the state's bits (positions, velocities, spins, histories, time): identical
+// A hash of the state's bits (positions, velocities, spins, histories, bodies, time): identical
 // states, and only those, hash the same.
 std::string state_hash(const State& state);
 

@@ -94,7 +94,7 @@ def clump(csv: Path) -> None:
     ax.grid(alpha=0.3, which="both")
     cost = ax.twinx()
     cost.plot(data["spheres"], data["relative_cost"], "k:", label="relative cost")
-    cost.set_ylabel("simulation cost relative to one sphere [-]")
+    cost.set_ylabel("time per step relative to spheres [-]")
     lines = ax.get_legend_handles_labels()
     more = cost.get_legend_handles_labels()
     ax.legend(lines[0] + more[0], lines[1] + more[1], loc="upper center")

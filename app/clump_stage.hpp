@@ -1,0 +1,24 @@
+#pragma once
+// A grain shape's clump template from its mesh file: import, repair within a tenth of the clump
+// tolerance, then the greedy sphere choice (mesh/clump.hpp). Shared by `diefill clump` and the
+// pipeline's `powder.shape`.
+#include <cstdint>
+#include <filesystem>
+
+#include "mesh/clump.hpp"
+#include "mesh/trimesh.hpp"
+
+namespace app {
+
+struct ClumpRequest {
+  std::filesystem::path mesh;
+  mesh::LengthUnit unit = mesh::LengthUnit::mm;
+  double tolerance = 0.05;
+  int max_spheres = 64;
+  std::uint64_t seed = 1;
+};
+
+// Throws InputError for a mesh that cannot be repaired or a tolerance the spheres cannot meet.
+mesh::ClumpTemplate build_clump(const ClumpRequest& request);
+
+}  // namespace app
