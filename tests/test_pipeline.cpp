@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "app/pipeline.hpp"
+#include "core/error.hpp"
 #include "app/pipeline_scene.hpp"
 #include "dem/io.hpp"
 #include "postprocess/density.hpp"
@@ -200,4 +201,20 @@ TEST(Pipeline, ClumpGrainsFillTheRingWithoutLeaking) {
   std::printf("ring with capsule clumps: %lld of %lld grains in the cavity, fill ratio %.4f\n",
               (long long)p["in_cavity"].get<std::int64_t>(), (long long)p["inserted"].get<std::int64_t>(),
               r["fill"]["fill_ratio"].get<double>());
+}
+
+// This mesh's shells pass every check we can make, yet CGAL's corefinement crashed on them in
+// the pipeline's coarser repair settings; the union now runs in a child process, and the run
+// stops with the repair's error instead of a segmentation fault.
+TEST(Pipeline, MeshThatCrashedCorefinementIsRefusedClearly) {
+  REQUIRE_SHARED_MESHES();
+  app::PipelineScene scene = app::load_pipeline_scene(
+      std::nullopt, {"powder.max_grains=3000", "output.directory=" + (suite_out() / "refused").string()});
+  try {
+    app::run_die_fill(scene, test::shared_meshes() / "dies" / "broken" / "assimp_3DSMaxExport.stl", false);
+    ADD_FAILURE() << "the mesh was accepted";
+  } catch (const diefill::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("assimp_3DSMaxExport.stl"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("tolerance"), std::string::npos) << e.what();
+  }
 }
