@@ -66,13 +66,7 @@ int run_simulate(const SimulateCommand& c) {
       {"timing",
        {{"wall_s", result.wall_s},
         {"particle_steps_per_s", double(result.steps) * double(state.size()) / std::max(1e-9, result.wall_s)},
-        {"stages",
-         {{"neighbours", result.times.neighbours},
-          {"pair_forces", result.times.pair_forces},
-          {"sums", result.times.sums},
-          {"wall_forces", result.times.wall_forces},
-          {"integration", result.times.integration},
-          {"monitor", result.times.monitor}}}}},
+        {"stages", stage_times_json(result.times)}}},
       {"stability", {{"max_overlap_rel", state.counters.max_overlap_rel}}}};
   diefill::write_file_atomic(dir / "summary.json", summary.dump(2) + "\n");
   if (result.interrupted) {

@@ -59,4 +59,9 @@ LoopResult run_until(const dem::Model& model, dem::State& s, const LoopOptions& 
   return result;
 }
 
+nlohmann::json stage_times_json(const dem::StageTimes& t) {
+  return {{"neighbours", t.neighbours}, {"pair_forces", t.pair_forces}, {"sums", t.sums},
+          {"wall_forces", t.wall_forces}, {"integration", t.integration}, {"monitor", t.monitor}};
+}
+
 }  // namespace app

@@ -4,6 +4,7 @@
 // StabilityError (exit status 3).
 #include <filesystem>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "dem/model.hpp"
@@ -33,5 +34,8 @@ struct LoopResult {
 void install_interrupt_handler();
 
 LoopResult run_until(const dem::Model& model, dem::State& state, const LoopOptions& options);
+
+// Seconds per stage, as the reports write them.
+nlohmann::json stage_times_json(const dem::StageTimes& times);
 
 }  // namespace app
