@@ -172,12 +172,12 @@ TEST(Pipeline, FillRatioFallsWithShoeSpeedFromThePouredDensity) {
 
 // Modelling no more than the scene needs: the powder beyond the die's width plus a margin never
 // reaches the cavity, so the trimmed shoe must fill the die as the full 50 mm shoe does, within
-// the spread between seeds (measured 0.006 in fill ratio; the bound allows three times that).
+// the spread between seeds (seeds 1 and 2 differ by 0.006 in fill ratio, RingFieldIsMirror...
+// runs both; the bound allows three times that).
 TEST(Pipeline, TrimmedShoeFillsLikeTheFullShoe) {
   const double trimmed = run("ring", 0.1, 1)["fill"]["fill_ratio"].get<double>();
-  const double other_seed = run("ring", 0.1, 2, "seed2")["fill"]["fill_ratio"].get<double>();
   const double full = run("ring", 0.1, 1, "full", coarse + " shoe.trim_width=false")["fill"]["fill_ratio"].get<double>();
-  std::printf("ring fill ratio: trimmed shoe %.4f (seed 2: %.4f), full shoe %.4f\n", trimmed, other_seed, full);
+  std::printf("ring fill ratio: trimmed shoe %.4f, full shoe %.4f\n", trimmed, full);
   EXPECT_LT(std::abs(full - trimmed), 0.02);
 }
 
