@@ -250,7 +250,15 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
     LoopOptions loop;
     loop.until = s.shoe_settle_time;
     loop.label = die.name + ": settling the shoe";
-    run_until(settle_model, fill, loop);
+    // Interrupted while settling: nothing is cached (a half-settled shoe must never be reused);
+    // a resumed run settles afresh.
+    if (run_until(settle_model, fill, loop).interrupted) {
+      DieRun stopped;
+      stopped.die = die.name;
+      stopped.dir = dir;
+      stopped.interrupted = true;
+      return stopped;
+    }
     if (clumps) state = std::move(fill);
     else dem::write_particles_csv(fill, settled);
   }
