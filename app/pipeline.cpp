@@ -355,6 +355,8 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
   dem::write_particles_csv(state, out / "particles.csv");
   dem::write_vtu(state, out / "final.vtu");
   diefill::write_file_atomic(out / "scene.toml", describe(s));
+  // Summed from the same weighted members the density binning gets, so that the report shows
+  // the volume the field holds (a clump's true volume, not its overlapping spheres').
   double grain_volume_total = 0;
   {
     std::vector<post::Grain> all;
