@@ -92,4 +92,16 @@ struct ClumpCommand {
 };
 int run_clump(const ClumpCommand& command);
 
+struct StudyCommand {
+  std::string name;
+  std::optional<std::filesystem::path> scene;  // the powder to study (default: the pipeline's)
+  std::vector<std::string> overrides;
+  std::filesystem::path out = "out/studies";
+  bool reduced = false;  // the small version the tests run
+  std::optional<int> threads;
+  std::optional<std::uint64_t> seed;
+};
+int run_study(const StudyCommand& command);
+std::vector<std::string> study_names();
+
 }  // namespace app

@@ -99,6 +99,20 @@ void add_clump(CLI::App& root, app::ClumpCommand& c, std::function<int()>& actio
   cmd->callback([&] { action = [&] { return app::run_clump(c); }; });
 }
 
+void add_study(CLI::App& root, app::StudyCommand& c, std::function<int()>& action) {
+  std::string names;
+  for (const std::string& name : app::study_names()) names += (names.empty() ? "" : ", ") + name;
+  CLI::App* cmd = root.add_subcommand("study", "Calibration and method studies; CSV, JSON and PNG charts in OUT/NAME/");
+  cmd->add_option("NAME", c.name, "Study: " + names)->required();
+  cmd->add_option("SCENE", c.scene, "Scene (.toml) whose powder and contact laws are studied (default: the pipeline's)");
+  cmd->add_option("--set", c.overrides, "Override a scene key: --set powder.coarse_graining=16");
+  cmd->add_option("--out", c.out, "Output folder")->capture_default_str();
+  cmd->add_flag("--reduced", c.reduced, "The small version the tests run (coarser, fewer points; minutes)");
+  cmd->add_option("--threads", c.threads, "Threads (default: all cores); results do not depend on it");
+  cmd->add_option("--seed", c.seed, "Random seed of the powder");
+  cmd->callback([&] { action = [&] { return app::run_study(c); }; });
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -127,6 +141,8 @@ int main(int argc, char** argv) {
   add_die(root, die, action);
   app::ClumpCommand clump;
   add_clump(root, clump, action);
+  app::StudyCommand study;
+  add_study(root, study, action);
   try {
     root.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -4,6 +4,7 @@
 #include <omp.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "app/clump_stage.hpp"
@@ -29,12 +30,6 @@ using diefill::InputError;
 using dem::Vec3;
 
 namespace {
-
-int material_named(const dem::ModelSpec& spec, const std::string& name) {
-  for (std::size_t m = 0; m < spec.materials.size(); ++m)
-    if (spec.materials[m].name == name) return int(m);
-  throw InputError("scene", "materials", "has no material named \"" + name + "\"", "Define it");
-}
 
 // Where the shoe goes: its inner rectangle centred at (x, y_centre) on the table.
 struct ShoePlan {
@@ -77,6 +72,22 @@ ShoePlan plan_shoe(const PipelineScene& s, const mesh::Box& die_box, double tabl
   p.t_motion = 0;
   for (const auto& seg : p.motion.segments) p.t_motion += seg.duration;
   return p;
+}
+
+// Upper bound of the radius of the largest sphere the cavity holds below the table: the distance
+// to the die is 1-Lipschitz, so the true maximum exceeds the sampled one by at most half a grid
+// diagonal. Distances beyond the field's band read as the band.
+double largest_inscribed_radius_bound(const mesh::WallField& die, const mesh::Box& cavity, double table_z, double spacing) {
+  const Vec3 size = cavity.size();
+  spacing = std::max(spacing, size.maxCoeff() / 64);
+  const int nx = int(size.x() / spacing) + 1, ny = int(size.y() / spacing) + 1, nz = int((table_z - cavity.lo.z()) / spacing) + 1;
+  double best = -std::numeric_limits<double>::infinity();
+#pragma omp parallel for collapse(2) reduction(max : best) schedule(static)
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j)
+      for (int k = 0; k < nz; ++k)
+        best = std::max(best, die.signed_distance(cavity.lo + spacing * Vec3(i + 0.5, j + 0.5, k + 0.5)));
+  return best + 0.5 * std::sqrt(3.0) * spacing;
 }
 
 // A grain once: a free sphere, or a clump by its centre of mass.
@@ -187,6 +198,19 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
     shoe_field = std::make_shared<const mesh::WallField>(mesh::build_sdf(shoe_mesh, shoe_sdf).wall_field(shoe_mesh));
   }
   auto die_field = std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid));
+  // Grains too coarse for the cavity: refused when none can enter it; warned when it is narrower
+  // than a few grains, where the wall layer is most of the part (PHYSICS.md §4).
+  const double inscribed = largest_inscribed_radius_bound(*die_field, box, table_z, 0.1 * r_max);
+  if (inscribed < r_max)
+    throw InputError(die_mesh.string(), "powder.coarse_graining",
+                     fmt::format("grains up to {:.3g} mm across cannot enter the cavity: the largest sphere it holds is at most "
+                                 "{:.3g} mm across",
+                                 2 * r_max * 1e3, 2 * inscribed * 1e3),
+                     "Lower powder.coarse_graining (or raise powder.max_grains, which coarsens grains for large shoes)");
+  if (inscribed < 1.5 * diameter)
+    diefill::log::warn("{}: the cavity holds no sphere wider than {:.3g} mm, under three grains of {:.3g} mm: the density "
+                       "there is mostly wall layer; lower powder.coarse_graining",
+                       die.name, 2 * inscribed * 1e3, diameter * 1e3);
 
   dem::ModelSpec spec = s.spec;
   // The collision time must resolve the fastest impact: a grain falling the die's depth onto the

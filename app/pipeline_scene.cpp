@@ -34,6 +34,12 @@ std::vector<dem::Material> default_materials() {
 
 }  // namespace
 
+int material_named(const dem::ModelSpec& spec, const std::string& name) {
+  for (std::size_t m = 0; m < spec.materials.size(); ++m)
+    if (spec.materials[m].name == name) return int(m);
+  throw diefill::InputError("scene", "materials", "has no material named \"" + name + "\"", "Define it");
+}
+
 PipelineScene load_pipeline_scene(const std::optional<std::filesystem::path>& scene_file,
                                   const std::vector<std::string>& overrides) {
   PipelineScene s;

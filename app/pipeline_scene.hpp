@@ -57,6 +57,8 @@ struct PipelineScene {
 // wrong types are errors with file and line.
 PipelineScene load_pipeline_scene(const std::optional<std::filesystem::path>& scene_file,
                                   const std::vector<std::string>& overrides);
+// Index of the material `name` ("powder", "steel"); InputError when the scene lacks it.
+int material_named(const dem::ModelSpec& spec, const std::string& name);
 // The fully resolved scene as TOML, every key with its value and the reason for its default.
 std::string describe(const PipelineScene& scene);
 

@@ -33,6 +33,10 @@ LoopResult run_until(const dem::Model& model, dem::State& s, const LoopOptions& 
     if (s.time >= next_output - 0.5 * model.dt && o.output) {
       o.output(s);
       next_output += o.output_every;
+      if (o.finished && o.finished(s)) {
+        result.finished_early = true;
+        break;
+      }
     }
     const dem::StepReport report = dem::step(model, s, &result.times);
     ++result.steps;
@@ -52,7 +56,7 @@ LoopResult run_until(const dem::Model& model, dem::State& s, const LoopOptions& 
                                                   o.detail ? ", " + o.detail(s) : std::string()));
     }
   }
-  if (o.output && !result.interrupted) o.output(s);
+  if (o.output && !result.interrupted && !result.finished_early) o.output(s);
   result.wall_s = clock.seconds();
   progress.finish(fmt::format("{} steps, {:.3g} particle-steps/s", result.steps,
                               double(result.steps) * double(grains) / std::max(1e-9, result.wall_s)));

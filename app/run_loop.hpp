@@ -19,6 +19,8 @@ struct LoopOptions {
   std::filesystem::path checkpoint;  // written on a stop (stability or Ctrl-C)
   double output_every = 0;           // [s]; 0: never
   std::function<void(const dem::State&)> output;
+  // Asked after each output: true ends the loop there (a drained container, a settled heap).
+  std::function<bool(const dem::State&)> finished;
   // Extra words for the progress line (grains in the cavity, ...).
   std::function<std::string(const dem::State&)> detail;
 };
@@ -28,6 +30,7 @@ struct LoopResult {
   double wall_s = 0;
   dem::StageTimes times;
   bool interrupted = false;  // Ctrl-C: a checkpoint was written
+  bool finished_early = false;  // options.finished said so
 };
 
 // Installs the Ctrl-C handler (once); a second Ctrl-C kills the process as usual.

@@ -154,6 +154,15 @@ Model compile_model(const ModelSpec& spec, const State& state, const std::string
     diefill::log::warn("{}: at {:.3g} m/s a grain moves {:.3g} m per step, more than half the neighbour skin "
                        "{:.3g} m: contacts could be missed. Lower the time step or widen the skin",
                        source, spec.max_impact_speed, spec.max_impact_speed * m.dt, m.skin);
+  // A wall's motion is known exactly, so a wall that could pass grains unseen is refused: the
+  // grains near it are listed at a rebuild, and a rebuild comes once it has moved half the skin.
+  for (const MeshWall& w : spec.meshes)
+    if (const double per_step = w.motion.top_speed() * m.dt; per_step > 0.5 * m.skin)
+      throw InputError(source, "walls." + w.name + ".motion",
+                       fmt::format("the wall moves {:.3g} m per step at its top speed {:.3g} m/s, more than half the neighbour "
+                                   "skin {:.3g} m: it could pass through grains it has not listed",
+                                   per_step, w.motion.top_speed(), m.skin),
+                       "Lower the wall's speed or the time step, or widen simulation.skin");
   m.cell_size = 2 * m.max_radius + m.skin;
 
   std::string text = fmt::format("dt={:a};skin={:a};g={:a},{:a},{:a};laws={},{},{},{};stop={:a};dom={:a},{:a},{:a},{:a},{:a},{:a}",

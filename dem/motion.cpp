@@ -1,5 +1,7 @@
 #include "dem/motion.hpp"
 
+#include <algorithm>
+
 namespace dem {
 
 Vec3 Motion::position(double t) const {
@@ -51,6 +53,12 @@ bool Motion::moves() const {
   for (const Segment& s : segments)
     if (s.acceleration.squaredNorm() > 0) return true;
   return false;
+}
+
+double Motion::top_speed() const {
+  double top = start_velocity.norm(), t = 0;
+  for (const Segment& s : segments) top = std::max(top, velocity(t += s.duration).norm());
+  return top;
 }
 
 }  // namespace dem

@@ -28,6 +28,9 @@ struct Motion {
   Vec3 to_world(double t, const Vec3& local) const;
   Vec3 to_local(double t, const Vec3& world) const;
   bool moves() const;
+  // Largest translation speed over the whole motion [m/s] (the velocity is piecewise linear in
+  // time, so its norm peaks where a segment starts or ends).
+  double top_speed() const;
 };
 
 }  // namespace dem

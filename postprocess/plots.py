@@ -5,6 +5,7 @@
                                   (from OUT_DIR/plot_data.json)
     plots.py clump NAME_errors.csv  ->  NAME_errors.png: a clump's errors and cost against its
                                         sphere count
+    plots.py study DIR/NAME.json  ->  every chart the study lists under "charts", into DIR
 
 Each picture has axes with units and, where colour carries a value, a colour bar.
 """
@@ -104,5 +105,37 @@ def clump(csv: Path) -> None:
     plt.close(fig)
 
 
+def study(document: Path) -> None:
+    """Charts described by the study itself: series of points (with error bars) or lines."""
+    data = json.loads(document.read_text())
+    markers = iter("osD^vP*X" * 4)
+    for chart in data["charts"]:
+        fig, ax = plt.subplots(figsize=(6.4, 4.4))
+        for series in chart["series"]:
+            if not series["x"]:
+                continue
+            if series["style"] == "line":
+                ax.plot(series["x"], series["y"], "-", label=series["label"])
+            else:
+                error = series["error"] if series["error"] else None
+                ax.errorbar(series["x"], series["y"], yerr=error, fmt=next(markers), capsize=3, label=series["label"])
+        if chart["log_x"]:
+            ax.set_xscale("log")
+        if chart["log_y"]:
+            ax.set_yscale("log")
+        if chart["y_ticks"]:
+            ax.set_yticks(range(len(chart["y_ticks"])))
+            ax.set_yticklabels(chart["y_ticks"])
+            ax.set_ylim(-0.5, len(chart["y_ticks"]) - 0.5)
+        ax.set_xlabel(chart["x_label"])
+        ax.set_ylabel(chart["y_label"])
+        ax.set_title(chart["title"])
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize="small")
+        fig.tight_layout()
+        fig.savefig(document.parent / chart["file"], dpi=120)
+        plt.close(fig)
+
+
 if __name__ == "__main__":
-    {"density": density, "clump": clump}[sys.argv[1]](Path(sys.argv[2]))
+    {"density": density, "clump": clump, "study": study}[sys.argv[1]](Path(sys.argv[2]))

@@ -1,0 +1,23 @@
+#pragma once
+// The studies of `diefill study NAME` (the seed study's calibration experiments), each writing
+// its tables, NAME.json and charts through `out`. `reduced` runs the small version the test
+// suite uses: fewer and coarser grains, fewer points, the same law checked.
+#include "app/pipeline_scene.hpp"
+#include "app/study_kit.hpp"
+
+namespace app::study {
+
+// Mass flow through a slot against its width (Beverloo slot law: C_s, k), and the mass a moving
+// shoe delivers through a die opening into a bin against its speed (moving-container law,
+// critical-velocity law: v_c, n).
+void discharge(const PipelineScene& scene, bool reduced, Output& out);
+
+// Heap and outflow angles of repose against sliding and rolling friction, with the Zhou et al.
+// correlation for comparison.
+void repose(const PipelineScene& scene, bool reduced, Output& out);
+
+// Where each method fails (time step, wall voxels, shoe speed against the skin, grains too
+// coarse for the cavity): each probed, and whether the stability checks caught it.
+void stability(const PipelineScene& scene, bool reduced, Output& out);
+
+}  // namespace app::study

@@ -1,0 +1,132 @@
+#include "app/study_kit.hpp"
+
+#include <fmt/core.h>
+
+#include <cmath>
+
+#include "app/density_stage.hpp"
+#include "dem/insert.hpp"
+#include "dem/step.hpp"
+#include "mesh/sdf.hpp"
+#include "mesh/shapes.hpp"
+
+namespace app::study {
+
+namespace fs = std::filesystem;
+using dem::Vec3;
+
+Powder powder_of(const PipelineScene& scene) {
+  Powder p;
+  p.spec = scene.spec;
+  p.powder = material_named(scene.spec, "powder");
+  p.wall = material_named(scene.spec, "steel");
+  p.diameter = scene.grain_diameter();
+  p.spread = scene.diameter_spread;
+  p.density = scene.spec.materials[std::size_t(p.powder)].density;
+  p.seed = scene.seed;
+  p.source = scene.source;
+  return p;
+}
+
+dem::MeshWall block_wall(const Vec3& lo, const Vec3& hi, double r_max, int material, const std::string& name) {
+  // The wall query is exact; the voxels only find candidate triangles (as for the shoe).
+  const double voxel = 0.5 * r_max;
+  const mesh::TriMesh block = mesh::box_solid(lo, hi);
+  const mesh::SdfOptions options{voxel, 1.5 * r_max + voxel, 2 * voxel, false};
+  return dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(mesh::build_sdf(block, options).wall_field(block)),
+                              material, name);
+}
+
+std::size_t add_grains(dem::State& state, const dem::Box3& region, const Powder& powder, std::size_t count,
+                       std::uint64_t seed, const dem::Model* clear_of) {
+  dem::InsertRegion where;
+  where.box = region;
+  where.clear_of_walls = clear_of;
+  dem::InsertRequest request;
+  request.count = count;
+  request.radius = 0.5 * powder.diameter;
+  request.radius_spread = powder.spread;
+  request.max_solid_fraction = 0.45;
+  request.material = powder.powder;
+  request.density = powder.density;
+  request.seed = seed;
+  request.first_id = std::int64_t(state.size());
+  return dem::insert_spheres(state, where, request);
+}
+
+void advance(const dem::Model& model, dem::State& state, double until, const std::string& label, LoopOptions loop) {
+  loop.until = until;
+  loop.label = label;
+  if (run_until(model, state, loop).interrupted) throw Interrupted{};
+}
+
+void forget_wall_contacts(dem::State& state) {
+  for (dem::WallSlot& slot : state.wall_slots) slot = dem::WallSlot{};
+}
+
+LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y) {
+  LineFit fit;
+  fit.points = x.size();
+  const double n = double(x.size());
+  if (x.size() < 2) return fit;
+  double mx = 0, my = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) mx += x[i], my += y[i];
+  mx /= n, my /= n;
+  double sxx = 0, sxy = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) sxx += (x[i] - mx) * (x[i] - mx), sxy += (x[i] - mx) * (y[i] - my);
+  if (sxx <= 0) return fit;
+  fit.slope = sxy / sxx;
+  fit.intercept = my - fit.slope * mx;
+  if (x.size() > 2) {
+    double ssr = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) ssr += std::pow(y[i] - fit.intercept - fit.slope * x[i], 2);
+    const double variance = ssr / (n - 2);
+    fit.slope_error = std::sqrt(variance / sxx);
+    fit.intercept_error = std::sqrt(variance * (1 / n + mx * mx / sxx));
+  }
+  return fit;
+}
+
+Output::Output(const fs::path& root, const std::string& name)
+    : name_(name), directory_(root / name), work_(root / name / "runs"), staging_(root / name) {}
+
+void Output::table(const std::string& file, const std::vector<std::string>& columns,
+                   const std::vector<std::vector<nlohmann::json>>& rows) {
+  std::string text;
+  for (std::size_t c = 0; c < columns.size(); ++c) text += (c ? "," : "") + columns[c];
+  text += "\n";
+  for (const auto& row : rows) {
+    for (std::size_t c = 0; c < row.size(); ++c) {
+      // Numbers in full precision; text as is (studies write no commas into it).
+      text += c ? "," : "";
+      text += row[c].is_string() ? row[c].get<std::string>() : row[c].dump();
+    }
+    text += "\n";
+  }
+  diefill::write_file_atomic(staging_ / file, text);
+}
+
+void Output::chart(Chart chart) {
+  nlohmann::json series = nlohmann::json::array();
+  for (const Series& s : chart.series)
+    series.push_back({{"label", s.label}, {"x", s.x}, {"y", s.y}, {"error", s.error}, {"style", s.style}});
+  charts_.push_back({{"file", chart.file},
+                     {"title", chart.title},
+                     {"x_label", chart.x_label},
+                     {"y_label", chart.y_label},
+                     {"log_x", chart.log_x},
+                     {"log_y", chart.log_y},
+                     {"y_ticks", chart.y_ticks},
+                     {"series", series}});
+}
+
+void Output::commit() {
+  nlohmann::json document = results;
+  document["charts"] = charts_;
+  const fs::path json = staging_ / (name_ + ".json");
+  diefill::write_file_atomic(json, document.dump(2) + "\n");
+  draw_pictures({"study", json.string()});
+  staging_.commit();
+}
+
+}  // namespace app::study

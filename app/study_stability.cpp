@@ -1,0 +1,217 @@
+// `diefill study stability`: where each method fails, and whether diefill says so. Four probes,
+// each swept across its limit:
+//  - the time step against the stable limit (min of the Rayleigh and Hertz times): a pack dropped
+//    into a box;
+//  - the die's voxel against the grain radius: grains dropped into the ring die;
+//  - a wall's travel per step against half the neighbour skin: a block pushed through a bed;
+//  - the grain diameter against the ring's annulus width: the whole pipeline.
+// Each run ends one of four ways: it ran and its result checks out; a stability check stopped
+// it (exit 3); a check refused it before it ran (exit 2); or it ran and the result is wrong
+// without any check noticing — the outcome this study exists to rule out.
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
+#include "app/pipeline.hpp"
+#include "app/studies.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "dem/insert.hpp"
+#include "dem/step.hpp"
+#include "dem/walls.hpp"
+#include "mesh/die.hpp"
+#include "mesh/import.hpp"
+#include "mesh/shapes.hpp"
+
+namespace app::study {
+
+namespace {
+
+using dem::Vec3;
+
+enum class Outcome { passed, stopped, refused, wrong };
+constexpr const char* outcome_names[] = {"ran, checks passed", "stopped by a stability check", "refused before running",
+                                         "ran, wrong and not caught"};
+
+struct Probe {
+  std::string name, parameter;
+  double ratio;
+  Outcome outcome;
+  std::string detail;  // the check's message, or what the result showed
+};
+
+// Runs `body`, which returns what its result showed (empty when the result checks out).
+Probe probe(const std::string& name, const std::string& parameter, double ratio, const std::function<std::string()>& body) {
+  Probe p{name, parameter, ratio, Outcome::passed, ""};
+  try {
+    p.detail = body();
+    if (!p.detail.empty()) p.outcome = Outcome::wrong;
+  } catch (const diefill::StabilityError& e) {
+    p.outcome = Outcome::stopped, p.detail = e.what();
+  } catch (const diefill::InputError& e) {
+    p.outcome = Outcome::refused, p.detail = e.what();
+  }
+  diefill::log::info("stability: {} = {:.3g}: {}{}", parameter, ratio, outcome_names[int(p.outcome)],
+                     p.detail.empty() ? "" : " (" + p.detail + ")");
+  return p;
+}
+
+dem::PlaneWall plane(const Vec3& point, const Vec3& normal, int material) { return {point, normal, material, "box"}; }
+
+// Floor and four sides of a box [-half, half]² from z = 0.
+std::vector<dem::PlaneWall> box_planes(double half, int material) {
+  return {plane(Vec3::Zero(), Vec3::UnitZ(), material), plane(Vec3(-half, 0, 0), Vec3::UnitX(), material),
+          plane(Vec3(half, 0, 0), -Vec3::UnitX(), material), plane(Vec3(0, -half, 0), Vec3::UnitY(), material),
+          plane(Vec3(0, half, 0), -Vec3::UnitY(), material)};
+}
+
+// What a settled bed should show: nothing lost, no overlap beyond a few per cent.
+std::string settled_result_problems(const dem::State& s, double limit_overlap) {
+  if (s.lost > 0) return fmt::format("{} grains lost", s.lost);
+  if (s.counters.max_overlap_rel > limit_overlap)
+    return fmt::format("largest overlap {:.3g} of a radius", s.counters.max_overlap_rel);
+  return "";
+}
+
+std::string time_step_run(const Powder& powder, double fraction) {
+  const double d = powder.diameter, half = 5 * d;
+  dem::ModelSpec spec = powder.spec;
+  spec.planes = box_planes(half, powder.wall);
+  spec.domain = {Vec3(-half - d, -half - d, -d), Vec3(half + d, half + d, 30 * d)};
+  dem::State state;
+  add_grains(state, {Vec3(-half + d, -half + d, d), Vec3(half - d, half - d, 20 * d)}, powder, 400, powder.seed);
+  const dem::Model automatic = dem::compile_model(spec, state, powder.source);
+  spec.time_step = fraction * std::min(automatic.dt_rayleigh, automatic.dt_hertz);
+  const dem::Model model = dem::compile_model(spec, state, powder.source);
+  dem::initialize(model, state);
+  advance(model, state, 0.15, fmt::format("stability: time step {:.3g} of the limit", fraction));
+  return settled_result_problems(state, 0.05);
+}
+
+// The bundled ring die (annulus 5 mm wide, 10 mm deep), written once into the work folder.
+std::filesystem::path ring_mesh(const std::filesystem::path& work) {
+  const std::filesystem::path ring = work / "ring.stl";
+  if (!std::filesystem::exists(ring)) {
+    std::filesystem::create_directories(work);
+    mesh::write_stl(mesh::bundled_die("ring"), ring, mesh::LengthUnit::mm, "diefill ring die");
+  }
+  return ring;
+}
+
+std::string voxel_run(const Powder& powder, double voxel_over_radius, const std::filesystem::path& work) {
+  const double r = powder.r_max();
+  const std::filesystem::path ring = ring_mesh(work);
+  const mesh::DieOptions options = mesh::die_options_for_grains(r, 0.5 * r, voxel_over_radius * r);
+  const mesh::PreparedDie die = mesh::prepare_die(ring, options, work / ".cache");
+  auto field = std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid));
+  dem::ModelSpec spec = powder.spec;
+  spec.skin = 0.5 * r;  // the default comes from the grains, and the first model has none
+  spec.meshes = {dem::fixed_mesh_wall(field, powder.wall, "die")};
+  const mesh::Box box = mesh::bounding_box(die.cavity);
+  spec.domain = {box.lo - Vec3::Constant(5e-3), box.hi + Vec3(5e-3, 5e-3, 30e-3)};
+  spec.max_impact_speed = std::max(spec.max_impact_speed, std::sqrt(2 * spec.gravity.norm() * 25e-3));
+  dem::State state;
+  const dem::Model empty = dem::compile_model(spec, state, powder.source);
+  dem::InsertRegion region;
+  region.box = {Vec3(box.lo.x(), box.lo.y(), box.lo.z() + r), Vec3(box.hi.x(), box.hi.y(), box.hi.z() + 15e-3)};
+  region.clear_of_walls = &empty;
+  // Straight above the annulus, so that every grain falls into the cavity.
+  region.accept = [&](const Vec3& x, double radius) {
+    const double rho = std::hypot(x.x(), x.y());
+    return rho - radius > 5e-3 && rho + radius < 10e-3;
+  };
+  dem::InsertRequest request;
+  request.count = 600;
+  request.radius = 0.5 * powder.diameter;
+  request.radius_spread = powder.spread;
+  request.material = powder.powder;
+  request.density = powder.density;
+  request.seed = powder.seed;
+  dem::insert_spheres(state, region, request);
+  const dem::Model model = dem::compile_model(spec, state, powder.source);
+  dem::initialize(model, state);
+  advance(model, state, 0.12, fmt::format("stability: voxel {:.3g} grain radii", voxel_over_radius));
+  std::size_t inside = 0;
+  for (std::size_t i = 0; i < state.size(); ++i)
+    inside += state.active[i] && field->signed_distance(state.x[i]) < 0;
+  if (inside > 0) return fmt::format("{} grain centres inside the die", inside);
+  return settled_result_problems(state, 0.05);
+}
+
+std::string wall_speed_run(const Powder& powder, double step_over_half_skin) {
+  // Slow enough that the push itself keeps overlaps near 1 %: what grows past it is the skin's doing.
+  const double d = powder.diameter, r = powder.r_max(), half = 6 * d, speed = 0.1;
+  dem::ModelSpec spec = powder.spec;
+  spec.planes = box_planes(half, powder.wall);
+  spec.domain = {Vec3(-half - d, -half - d, -d), Vec3(half + d, half + d, 20 * d)};
+  dem::State state;
+  add_grains(state, {Vec3(-half + d, -half + d, d), Vec3(half - d, half - d, 6 * d)}, powder, 300, powder.seed);
+  // A block as wide as the box sweeps the bed; the skin sets the ratio.
+  const dem::Model automatic = dem::compile_model(spec, state, powder.source);
+  spec.skin = 2 * speed * automatic.dt / step_over_half_skin;
+  dem::MeshWall block = block_wall(Vec3(-2 * d, -half, 0), Vec3(0, half, 4 * d), r, powder.wall, "pusher");
+  block.motion.start_position = Vec3(-half - 0.5 * d, 0, 0.2 * d);
+  block.motion.start_velocity = Vec3(speed, 0, 0);
+  spec.meshes = {block};
+  const dem::Model model = dem::compile_model(spec, state, powder.source);
+  dem::initialize(model, state);
+  advance(model, state, 8 * d / speed, fmt::format("stability: wall step {:.3g} of half the skin", step_over_half_skin));
+  return settled_result_problems(state, 0.1);
+}
+
+std::string coarse_cavity_run(const PipelineScene& scene, double diameter_over_width, const std::filesystem::path& work) {
+  // The ring's annulus is 5 mm wide.
+  PipelineScene s = scene;
+  s.coarse_graining = diameter_over_width * 5e-3 / s.particle_diameter;
+  s.out = work / fmt::format("cavity_{:.3g}", diameter_over_width);
+  const DieRun run = run_die_fill(s, ring_mesh(work), false);
+  const auto& particles = run.report["particles"];
+  if (particles.value("in_cavity", 0) == 0) return "no grain entered the cavity";
+  if (particles.value("lost", 0) > 0) return "grains lost";
+  return "";
+}
+
+}  // namespace
+
+void stability(const PipelineScene& scene, bool reduced, Output& out) {
+  const Powder powder = powder_of(scene);
+  const std::filesystem::path work = out.work();
+  const std::vector<double> time_steps = reduced ? std::vector<double>{0.15, 2.0} : std::vector<double>{0.1, 0.2, 0.4, 0.7, 1.0, 1.5, 2.5};
+  const std::vector<double> voxels = reduced ? std::vector<double>{0.25, 4.0} : std::vector<double>{0.25, 0.5, 1, 2, 4, 8};
+  const std::vector<double> wall_steps = reduced ? std::vector<double>{0.5, 2.0} : std::vector<double>{0.25, 0.5, 0.9, 1.1, 2, 4};
+  const std::vector<double> cavity = reduced ? std::vector<double>{0.5, 1.2} : std::vector<double>{0.3, 0.5, 0.8, 1.0, 1.2};
+
+  std::vector<Probe> probes;
+  const std::vector<std::string> rows = {"time step / stable limit", "die voxel / grain radius", "wall travel per step / half skin",
+                                         "grain diameter / cavity width"};
+  for (double f : time_steps) probes.push_back(probe("time_step", rows[0], f, [&] { return time_step_run(powder, f); }));
+  for (double f : voxels) probes.push_back(probe("voxel", rows[1], f, [&] { return voxel_run(powder, f, work); }));
+  for (double f : wall_steps) probes.push_back(probe("wall_speed", rows[2], f, [&] { return wall_speed_run(powder, f); }));
+  for (double f : cavity) probes.push_back(probe("coarse_grains", rows[3], f, [&] { return coarse_cavity_run(scene, f, work); }));
+
+  std::vector<std::vector<nlohmann::json>> table;
+  nlohmann::json list = nlohmann::json::array();
+  Chart map("stability_map.png", "Where each method fails, and what diefill does about it", "ratio to the method's limit", "");
+  map.log_x = true;
+  map.y_ticks = rows;
+  for (int o = 0; o < 4; ++o) map.series.push_back({outcome_names[o], {}, {}, {}, "points"});
+  for (const Probe& p : probes) {
+    const auto row = double(std::find(rows.begin(), rows.end(), p.parameter) - rows.begin());
+    map.series[std::size_t(p.outcome)].x.push_back(p.ratio);
+    map.series[std::size_t(p.outcome)].y.push_back(row);
+    // The CSV keeps the message on one line and free of commas.
+    std::string detail = p.detail;
+    std::replace(detail.begin(), detail.end(), ',', ';');
+    std::replace(detail.begin(), detail.end(), '\n', ' ');
+    table.push_back({p.name, p.ratio, outcome_names[int(p.outcome)], detail});
+    list.push_back({{"probe", p.name}, {"parameter", p.parameter}, {"ratio", p.ratio}, {"outcome", outcome_names[int(p.outcome)]},
+                    {"detail", p.detail}});
+  }
+  out.table("stability.csv", {"probe", "ratio", "outcome", "detail"}, table);
+  out.chart(map);
+  out.results = {{"grain_diameter_m", powder.diameter}, {"probes", list}};
+}
+
+}  // namespace app::study
