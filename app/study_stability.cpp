@@ -110,7 +110,8 @@ std::string voxel_run(const Powder& powder, double voxel_over_radius, const std:
   spec.skin = 0.5 * r;  // the default comes from the grains, and the first model has none
   spec.meshes = {dem::fixed_mesh_wall(field, powder.wall, "die")};
   const mesh::Box box = mesh::bounding_box(die.cavity);
-  spec.domain = {box.lo - Vec3::Constant(5e-3), box.hi + Vec3(5e-3, 5e-3, 30e-3)};
+  // Wide enough that only a grain through the die leaves it (downwards).
+  spec.domain = {box.lo - Vec3(25e-3, 25e-3, 5e-3), box.hi + Vec3(25e-3, 25e-3, 30e-3)};
   spec.max_impact_speed = std::max(spec.max_impact_speed, std::sqrt(2 * spec.gravity.norm() * 25e-3));
   dem::State state;
   const dem::Model empty = dem::compile_model(spec, state, powder.source);

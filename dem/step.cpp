@@ -70,9 +70,15 @@ std::string worst_overlap(const Model& model, const State& s) {
       const double rel = (s.radius[i] - hits[k].distance) / s.radius[i];
       const std::size_t w = std::size_t(hits[k].wall);
       const std::string& wall = w < model.planes.size() ? model.planes[w].name : model.meshes[w - model.planes.size()].name;
-      if (rel > worst)
-        worst = rel, where = fmt::format("grain {} and the wall \"{}\" at ({:.4g}, {:.4g}, {:.4g}) mm", s.id[i], wall,
-                                         1e3 * s.x[i].x(), 1e3 * s.x[i].y(), 1e3 * s.x[i].z());
+      if (rel <= worst) continue;
+      worst = rel, where = fmt::format("grain {} and the wall \"{}\" at ({:.4g}, {:.4g}, {:.4g}) mm", s.id[i], wall,
+                                       1e3 * s.x[i].x(), 1e3 * s.x[i].y(), 1e3 * s.x[i].z());
+      // Candidate triangles come from the voxels: coarser than the grain, they can miss a face.
+      if (w >= model.planes.size())
+        if (const double voxel = model.meshes[w - model.planes.size()].field->voxel; voxel > s.radius[i])
+          where += fmt::format(" (its voxels, {:.3g} mm, are coarser than the grain's radius {:.3g} mm, so a face near the "
+                               "grain can be missed: build the wall's field at a quarter of the grain radius)",
+                               voxel * 1e3, s.radius[i] * 1e3);
     }
   }
   return where;

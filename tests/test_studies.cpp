@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <map>
 
 #include <nlohmann/json.hpp>
 
@@ -56,6 +57,23 @@ TEST(Study, DischargeFollowsTheBeverlooSlotLawAndTheCriticalVelocityLaw) {
   EXPECT_TRUE(consistent_with(critical["n"], critical["n_error"], 1.0, 2.0)) << critical.dump();
   EXPECT_GT(critical["v_c_m_s"].get<double>(), 0.0);
   EXPECT_LT(critical["v_c_m_s"].get<double>(), shoe["speeds_m_s"][1].get<double>());
+}
+
+// Each method probed below and beyond its limit: below, the run passes its checks and its
+// result is right; beyond, a check stops or refuses it. No run may end wrong and unnoticed.
+TEST(Study, StabilityMapCatchesEveryFailure) {
+  const nlohmann::json r = run_reduced("stability");
+  std::map<std::string, std::vector<std::pair<double, std::string>>> by_probe;
+  for (const auto& p : r["probes"]) {
+    EXPECT_NE(p["outcome"].get<std::string>(), "ran, wrong and not caught") << p.dump();
+    by_probe[p["probe"]].push_back({p["ratio"], p["outcome"]});
+  }
+  EXPECT_EQ(by_probe.size(), 4u);
+  for (auto& [probe, runs] : by_probe) {
+    std::sort(runs.begin(), runs.end());
+    EXPECT_EQ(runs.front().second, "ran, checks passed") << probe;
+    EXPECT_TRUE(runs.back().second == "stopped by a stability check" || runs.back().second == "refused before running") << probe;
+  }
 }
 
 }  // namespace
