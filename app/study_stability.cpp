@@ -75,15 +75,30 @@ std::string settled_result_problems(const dem::State& s, double limit_overlap) {
   return "";
 }
 
-std::string time_step_run(const Powder& powder, double fraction) {
-  const double d = powder.diameter, half = 5 * d;
-  dem::ModelSpec spec = powder.spec;
-  spec.planes = box_planes(half, powder.wall);
-  spec.domain = {Vec3(-half - d, -half - d, -d), Vec3(half + d, half + d, 30 * d)};
+// `count` grains poured into a box of planes (2 half wide) up to `height`; the model with the
+// automatic time step and skin tells the probes their limits.
+struct BoxBed {
+  dem::ModelSpec spec;
   dem::State state;
-  add_grains(state, {Vec3(-half + d, -half + d, d), Vec3(half - d, half - d, 20 * d)}, powder, 400, powder.seed);
-  const dem::Model automatic = dem::compile_model(spec, state, powder.source);
-  spec.time_step = fraction * std::min(automatic.dt_rayleigh, automatic.dt_hertz);
+  dem::Model automatic;
+};
+
+BoxBed box_bed(const Powder& powder, double half, double height, std::size_t count) {
+  const double d = powder.diameter;
+  BoxBed bed;
+  bed.spec = powder.spec;
+  bed.spec.planes = box_planes(half, powder.wall);
+  bed.spec.domain = {Vec3(-half - d, -half - d, -d), Vec3(half + d, half + d, height + 10 * d)};
+  add_grains(bed.state, {Vec3(-half + d, -half + d, d), Vec3(half - d, half - d, height)}, powder, count, powder.seed);
+  bed.automatic = dem::compile_model(bed.spec, bed.state, powder.source);
+  return bed;
+}
+
+std::string time_step_run(const Powder& powder, double fraction) {
+  BoxBed bed = box_bed(powder, 5 * powder.diameter, 20 * powder.diameter, 400);
+  dem::ModelSpec& spec = bed.spec;
+  dem::State& state = bed.state;
+  spec.time_step = fraction * std::min(bed.automatic.dt_rayleigh, bed.automatic.dt_hertz);
   const dem::Model model = dem::compile_model(spec, state, powder.source);
   dem::initialize(model, state);
   advance(model, state, 0.15, fmt::format("stability: time step {:.3g} of the limit", fraction));
@@ -144,14 +159,11 @@ std::string voxel_run(const Powder& powder, double voxel_over_radius, const std:
 std::string wall_speed_run(const Powder& powder, double step_over_half_skin) {
   // Slow enough that the push itself keeps overlaps near 1 %: what grows past it is the skin's doing.
   const double d = powder.diameter, r = powder.r_max(), half = 6 * d, speed = 0.1;
-  dem::ModelSpec spec = powder.spec;
-  spec.planes = box_planes(half, powder.wall);
-  spec.domain = {Vec3(-half - d, -half - d, -d), Vec3(half + d, half + d, 20 * d)};
-  dem::State state;
-  add_grains(state, {Vec3(-half + d, -half + d, d), Vec3(half - d, half - d, 6 * d)}, powder, 300, powder.seed);
+  BoxBed bed = box_bed(powder, half, 6 * d, 300);
+  dem::ModelSpec& spec = bed.spec;
+  dem::State& state = bed.state;
   // A block as wide as the box sweeps the bed; the skin sets the ratio.
-  const dem::Model automatic = dem::compile_model(spec, state, powder.source);
-  spec.skin = 2 * speed * automatic.dt / step_over_half_skin;
+  spec.skin = 2 * speed * bed.automatic.dt / step_over_half_skin;
   dem::MeshWall block = block_wall(Vec3(-2 * d, -half, 0), Vec3(0, half, 4 * d), r, powder.wall, "pusher");
   block.motion.start_position = Vec3(-half - 0.5 * d, 0, 0.2 * d);
   block.motion.start_velocity = Vec3(speed, 0, 0);
@@ -194,7 +206,7 @@ void stability(const PipelineScene& scene, bool reduced, Output& out) {
 
   std::vector<std::vector<nlohmann::json>> table;
   nlohmann::json list = nlohmann::json::array();
-  Chart map("stability_map.png", "Where each method fails, and what diefill does about it", "ratio to the method's limit", "");
+  Chart map("stability_map.png", "Where each method fails", "ratio to the method's limit", "");
   map.log_x = true;
   map.y_ticks = rows;
   for (int o = 0; o < 4; ++o) map.series.push_back({outcome_names[o], {}, {}, {}, "points"});
