@@ -184,18 +184,17 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
 
   // 2. The shoe: a rectangular tube, its own SDF, moving rigidly on the table.
   //    A shoe from a mesh is a tool in its own frame: origin at the inner centre, on the table.
-  const double shoe_voxel = 0.5 * r_max;  // the query is exact; the voxels only find candidates
   std::shared_ptr<const mesh::WallField> shoe_field;
   if (!s.shoe_mesh.empty()) {
-    mesh::DieOptions shoe_options = mesh::die_options_for_grains(r_max, 0.5 * r_max, shoe_voxel);
+    // Voxels as mesh::contact_wall_field's: the query is exact, the voxels only find candidates.
+    mesh::DieOptions shoe_options = mesh::die_options_for_grains(r_max, 0.5 * r_max, 0.5 * r_max);
     shoe_options.unit = die_options.unit;
     shoe_options.role = mesh::WallRole::tool;
     const mesh::PreparedDie shoe_die = mesh::prepare_die(s.shoe_mesh, shoe_options, cache);
     shoe_field = std::make_shared<const mesh::WallField>(shoe_die.sdf.wall_field(shoe_die.solid));
   } else {
-    mesh::SdfOptions shoe_sdf{shoe_voxel, r_max + 0.5 * r_max + shoe_voxel, 2 * shoe_voxel, false};
-    const mesh::TriMesh shoe_mesh = mesh::shoe_solid(plan.length, plan.width, s.shoe_height, s.shoe_wall);
-    shoe_field = std::make_shared<const mesh::WallField>(mesh::build_sdf(shoe_mesh, shoe_sdf).wall_field(shoe_mesh));
+    shoe_field = std::make_shared<const mesh::WallField>(
+        mesh::contact_wall_field(mesh::shoe_solid(plan.length, plan.width, s.shoe_height, s.shoe_wall), r_max));
   }
   auto die_field = std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid));
   // Grains too coarse for the cavity: refused when none can enter it; warned when it is narrower

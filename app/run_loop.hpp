@@ -19,7 +19,7 @@ struct LoopOptions {
   std::filesystem::path checkpoint;  // written on a stop (stability or Ctrl-C)
   double output_every = 0;           // [s]; 0: never
   std::function<void(const dem::State&)> output;
-  // Asked after each output: true ends the loop there (a drained container, a settled heap).
+  // Asked after each output: true ends the loop there (a drained container).
   std::function<bool(const dem::State&)> finished;
   // Extra words for the progress line (grains in the cavity, ...).
   std::function<std::string(const dem::State&)> detail;

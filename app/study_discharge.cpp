@@ -162,6 +162,11 @@ void discharge(const PipelineScene& scene, bool reduced, Output& out) {
   mesh::write_stl(mesh::box_solid(Vec3(-0.5 * opening, -0.5 * opening, -depth), Vec3(0.5 * opening, 0.5 * opening, 0)), bin,
                   mesh::LengthUnit::mm, "diefill discharge study: deep die");
   const double capacity = bulk_density * opening * opening * depth;
+  // The law's mass, capped by what the die holds.
+  const auto law_mass = [&](double v) {
+    return std::min(capacity, moving_container_mass(fit, d, scene.shoe_length, opening, opening, v));
+  };
+  std::vector<double> law_error;
   std::vector<double> speeds, delivered;
   std::vector<std::vector<nlohmann::json>> shoe_rows;
   for (double v : z.speeds) {
@@ -176,8 +181,8 @@ void discharge(const PipelineScene& scene, bool reduced, Output& out) {
     const double mass = run.report["fill"].value("mass_kg", 0.0);
     speeds.push_back(v);
     delivered.push_back(mass);
-    const double law = std::min(capacity, moving_container_mass(fit, d, scene.shoe_length, opening, opening, v));
-    shoe_rows.push_back({v, mass, mass / capacity, law});
+    law_error.push_back(mass / law_mass(v) - 1);
+    shoe_rows.push_back({v, mass, mass / capacity, law_mass(v)});
   }
   // Critical velocity: delta = (v_c / v)^n where the die is clearly not full.
   std::vector<double> log_v, log_delta;
@@ -201,18 +206,13 @@ void discharge(const PipelineScene& scene, bool reduced, Output& out) {
   Series critical{fmt::format("critical velocity: v_c = {:.3f} m/s, n = {:.2f}", v_c, n), {}, {}, {}, "line"};
   for (double v : sweep(speeds.front() * 0.8, speeds.back() * 1.2, 60)) {
     container_law.x.push_back(v);
-    container_law.y.push_back(std::min(capacity, moving_container_mass(fit, d, scene.shoe_length, opening, opening, v)) * 1e3);
+    container_law.y.push_back(law_mass(v) * 1e3);
     critical.x.push_back(v);
     critical.y.push_back(capacity * (v <= v_c ? 1.0 : std::pow(v_c / v, n)) * 1e3);
   }
   mass_chart.series = {dem_points, container_law, critical};
   out.chart(mass_chart);
 
-  std::vector<double> law_error;
-  for (std::size_t i = 0; i < speeds.size(); ++i) {
-    const double law = std::min(capacity, moving_container_mass(fit, d, scene.shoe_length, opening, opening, speeds[i]));
-    law_error.push_back(delivered[i] / law - 1);
-  }
   out.results = {
       {"grain_diameter_m", d},
       {"slot",

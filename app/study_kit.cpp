@@ -5,7 +5,6 @@
 #include <cmath>
 
 #include "app/density_stage.hpp"
-#include "dem/insert.hpp"
 #include "dem/step.hpp"
 #include "mesh/sdf.hpp"
 #include "mesh/shapes.hpp"
@@ -29,19 +28,12 @@ Powder powder_of(const PipelineScene& scene) {
 }
 
 dem::MeshWall block_wall(const Vec3& lo, const Vec3& hi, double r_max, int material, const std::string& name) {
-  // The wall query is exact; the voxels only find candidate triangles (as for the shoe).
-  const double voxel = 0.5 * r_max;
-  const mesh::TriMesh block = mesh::box_solid(lo, hi);
-  const mesh::SdfOptions options{voxel, 1.5 * r_max + voxel, 2 * voxel, false};
-  return dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(mesh::build_sdf(block, options).wall_field(block)),
+  return dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(mesh::contact_wall_field(mesh::box_solid(lo, hi), r_max)),
                               material, name);
 }
 
-std::size_t add_grains(dem::State& state, const dem::Box3& region, const Powder& powder, std::size_t count,
-                       std::uint64_t seed, const dem::Model* clear_of) {
-  dem::InsertRegion where;
-  where.box = region;
-  where.clear_of_walls = clear_of;
+std::size_t add_grains(dem::State& state, const dem::InsertRegion& region, const Powder& powder, std::size_t count,
+                       std::uint64_t seed) {
   dem::InsertRequest request;
   request.count = count;
   request.radius = 0.5 * powder.diameter;
@@ -51,7 +43,7 @@ std::size_t add_grains(dem::State& state, const dem::Box3& region, const Powder&
   request.density = powder.density;
   request.seed = seed;
   request.first_id = std::int64_t(state.size());
-  return dem::insert_spheres(state, where, request);
+  return dem::insert_spheres(state, region, request);
 }
 
 void advance(const dem::Model& model, dem::State& state, double until, const std::string& label, LoopOptions loop) {

@@ -12,6 +12,7 @@
 #include "app/pipeline_scene.hpp"
 #include "app/run_loop.hpp"
 #include "core/atomic_file.hpp"
+#include "dem/insert.hpp"
 #include "dem/model.hpp"
 #include "dem/state.hpp"
 
@@ -36,10 +37,10 @@ Powder powder_of(const PipelineScene& scene);
 // An axis-aligned solid block [lo, hi] as a wall at rest.
 dem::MeshWall block_wall(const dem::Vec3& lo, const dem::Vec3& hi, double r_max, int material, const std::string& name);
 
-// Drops up to `count` non-overlapping grains into `region` (clear of the spec's walls); returns
-// how many fitted.
-std::size_t add_grains(dem::State& state, const dem::Box3& region, const Powder& powder, std::size_t count,
-                       std::uint64_t seed, const dem::Model* clear_of = nullptr);
+// Drops up to `count` of the powder's grains, clear of each other and of the grains present,
+// into `region` (loosely: below 0.45 solid fraction of its box); returns how many fitted.
+std::size_t add_grains(dem::State& state, const dem::InsertRegion& region, const Powder& powder, std::size_t count,
+                       std::uint64_t seed);
 
 // Steps to `until` [s] with the label, outputs and early end of `loop`; throws Interrupted on
 // Ctrl-C and StabilityError on a failed check.

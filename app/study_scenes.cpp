@@ -7,7 +7,6 @@
 #include <numbers>
 
 #include "core/error.hpp"
-#include "dem/insert.hpp"
 #include "dem/step.hpp"
 #include "mesh/sdf.hpp"
 #include "mesh/shapes.hpp"
@@ -84,7 +83,8 @@ SlotRun run_slot_container(const Powder& p, const SlotContainer& c, const std::s
   gated.planes.push_back(plane(Vec3::Zero(), Vec3::UnitZ(), p.wall, "gate"));
   SlotRun run;
   const auto wanted = std::size_t(c.length * c.width * c.fill_height * 0.6 / grain_volume(d));
-  const dem::Box3 region{Vec3(-half_l + r, -half_w + r, r), Vec3(half_l - r, half_w - r, pour_height)};
+  dem::InsertRegion region;
+  region.box = {Vec3(-half_l + r, -half_w + r, r), Vec3(half_l - r, half_w - r, pour_height)};
   add_grains(run.state, region, p, wanted, p.seed);
   const dem::Model shut = dem::compile_model(gated, run.state, p.source);
   dem::initialize(shut, run.state);
@@ -132,9 +132,7 @@ HeapRun run_heap(const Powder& p, const Heap& h, const std::string& label) {
   spec.materials.push_back(base_material);
   const int rough = int(spec.materials.size()) - 1;
   const mesh::TriMesh pedestal = mesh::ring_cavity(2 * h.pedestal_radius, 0, base, 0.01 * d);
-  const mesh::SdfOptions sdf{0.5 * r, 1.5 * r + 0.5 * r, r, false};
-  spec.meshes = {dem::fixed_mesh_wall(
-      std::make_shared<const mesh::WallField>(mesh::build_sdf(pedestal, sdf).wall_field(pedestal)), rough, "pedestal")};
+  spec.meshes = {dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(mesh::contact_wall_field(pedestal, r)), rough, "pedestal")};
 
   // Batches every 10 ms: a stream of the asked rate, each batch dropped just above the heap.
   const double batch_period = 0.01;
@@ -160,16 +158,7 @@ HeapRun run_heap(const Powder& p, const Heap& h, const std::string& label) {
     region.accept = [&](const Vec3& x, double radius) {
       return std::hypot(x.x(), x.y()) + radius <= h.stream_radius;
     };
-    dem::InsertRequest request;
-    request.count = std::min(per_batch, h.grains - poured);
-    request.radius = 0.5 * d;
-    request.radius_spread = p.spread;
-    request.max_solid_fraction = 0.45;
-    request.material = p.powder;
-    request.density = p.density;
-    request.seed = p.seed + std::uint64_t(batch);
-    request.first_id = std::int64_t(run.state.size());
-    const std::size_t added = dem::insert_spheres(run.state, region, request);
+    const std::size_t added = add_grains(run.state, region, p, std::min(per_batch, h.grains - poured), p.seed + std::uint64_t(batch));
     if (added == 0)
       throw diefill::InputError(p.source, "heap.stream_radius", "no grain fits in the stream", "Widen the stream");
     poured += added;

@@ -18,7 +18,6 @@
 #include "app/studies.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
-#include "dem/insert.hpp"
 #include "dem/step.hpp"
 #include "dem/walls.hpp"
 #include "mesh/die.hpp"
@@ -89,7 +88,9 @@ BoxBed box_bed(const Powder& powder, double half, double height, std::size_t cou
   bed.spec = powder.spec;
   bed.spec.planes = box_planes(half, powder.wall);
   bed.spec.domain = {Vec3(-half - d, -half - d, -d), Vec3(half + d, half + d, height + 10 * d)};
-  add_grains(bed.state, {Vec3(-half + d, -half + d, d), Vec3(half - d, half - d, height)}, powder, count, powder.seed);
+  dem::InsertRegion region;
+  region.box = {Vec3(-half + d, -half + d, d), Vec3(half - d, half - d, height)};
+  add_grains(bed.state, region, powder, count, powder.seed);
   bed.automatic = dem::compile_model(bed.spec, bed.state, powder.source);
   return bed;
 }
@@ -138,14 +139,7 @@ std::string voxel_run(const Powder& powder, double voxel_over_radius, const std:
     const double rho = std::hypot(x.x(), x.y());
     return rho - radius > 5e-3 && rho + radius < 10e-3;
   };
-  dem::InsertRequest request;
-  request.count = 600;
-  request.radius = 0.5 * powder.diameter;
-  request.radius_spread = powder.spread;
-  request.material = powder.powder;
-  request.density = powder.density;
-  request.seed = powder.seed;
-  dem::insert_spheres(state, region, request);
+  add_grains(state, region, powder, 600, powder.seed);
   const dem::Model model = dem::compile_model(spec, state, powder.source);
   dem::initialize(model, state);
   advance(model, state, 0.12, fmt::format("stability: voxel {:.3g} grain radii", voxel_over_radius));

@@ -289,4 +289,9 @@ SdfGrid build_sdf(const TriMesh& solid, const SdfOptions& options) {
 
 namespace mesh {
 std::string openvdb_version() { return openvdb::getLibraryVersionString(); }
+WallField contact_wall_field(const TriMesh& solid, double grain_radius) {
+  const double voxel = 0.5 * grain_radius;
+  return build_sdf(solid, {voxel, 1.5 * grain_radius + voxel, 2 * voxel, false}).wall_field(solid);
+}
+
 }  // namespace mesh

@@ -77,4 +77,9 @@ class SdfGrid {
 // flat-face distances by up to 0.06 voxel.
 SdfGrid build_sdf(const TriMesh& solid, const SdfOptions& options);
 
+// The wall field of a solid that grains of largest radius r touch only through exact queries:
+// voxels of r/2 merely seed the search for candidate triangles, and the band reaches a grain
+// centre in contact range plus a skin of r/2 (a shoe, a pedestal, a block).
+WallField contact_wall_field(const TriMesh& solid, double grain_radius);
+
 }  // namespace mesh
