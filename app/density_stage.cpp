@@ -18,12 +18,14 @@ DensityResult compute_density(const std::vector<post::Grain>& grains, const mesh
   // The cavity: the free side of the tool below the table (or the inside of a container).
   const bool container = die.sdf.metadata().count("role") && die.sdf.metadata().at("role") == "container";
   const double table = die.table_z;
-  auto into_cavity = [&](const post::Vec3& p) {
-    const double d = walls.signed_distance(p);
-    return container ? d : std::min(d, table - p.z());
-  };
   const mesh::Box box = die.after.bbox;
   const post::Vec3 lo(box.lo.x(), box.lo.y(), box.lo.z()), hi(box.hi.x(), box.hi.y(), container ? box.hi.z() : table);
+  // The cavity lies within its bounding box. Bounding by the box matters where the grid reaches
+  // past the die's field (coarse voxels below a thin table): there the field reads "free".
+  auto into_cavity = [&](const post::Vec3& p) {
+    const double into_box = std::min((p - lo).minCoeff(), (hi - p).minCoeff());
+    return std::min(walls.signed_distance(p), into_box);
+  };
   std::size_t in_box = 0;
   for (const post::Grain& g : grains)
     in_box += (g.centre.array() >= lo.array()).all() && (g.centre.array() <= hi.array()).all();

@@ -235,3 +235,19 @@ TEST(WallCorrection, LatticeProfileStaysFlatToTheWalls) {
       EXPECT_NEAR(p.solid_fraction[b] / l.phi, 1.0, 0.02) << "r = " << p.position[b];
   }
 }
+
+TEST(CavityVolume, NothingBelowAThinTableCountsAsCavity) {
+  // The pipeline's tool is a table 2 mm thick under the cavity; the density grid of coarse
+  // grains (3.2 mm voxels, aligned to the table) reaches 2.8 mm below the floor, beyond the
+  // die's field, where the field reads "free". Measured before the fix: 2.88 cm³ for 2.36.
+  mesh::DieOptions o = mesh::die_options_for_grains(0.88e-3, 0.44e-3);
+  o.table = mesh::TableExtent{-15e-3, -15e-3, 15e-3, 15e-3, 2e-3};
+  const mesh::PreparedDie die = mesh::prepare_die(test::source_dir() / "dies" / "ring.stl", o, std::nullopt);
+  const mesh::WallField walls = die.sdf.wall_field(die.solid);
+  app::DensitySettings s;
+  s.voxel_m = 3.2e-3;
+  const app::DensityResult r = app::compute_density({{Vec3(7.5e-3, 0, -5e-3), 0.8e-3, 1.0}}, die, walls, 7800, s, "one grain");
+  ASSERT_LT(r.field.grid.origin.z(), -12e-3) << "the grid must reach below the table for this test";
+  const double exact = std::numbers::pi * (10e-3 * 10e-3 - 5e-3 * 5e-3) * 10e-3;
+  EXPECT_NEAR(r.stats.cavity_volume_m3 / exact, 1.0, 0.01);
+}
