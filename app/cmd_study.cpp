@@ -20,7 +20,11 @@ using StudyFunction = std::function<void(const PipelineScene&, bool, study::Outp
 
 const std::map<std::string, StudyFunction>& studies() {
   static const std::map<std::string, StudyFunction> table = {
-      {"discharge", study::discharge}, {"repose", study::repose}, {"stability", study::stability}};
+      {"discharge", study::discharge},
+      {"repose", study::repose},
+      {"stability", study::stability},
+      {"coarse-graining", study::coarse_graining},
+      {"speed-accuracy", study::speed_accuracy}};
   return table;
 }
 

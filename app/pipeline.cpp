@@ -21,6 +21,7 @@
 #include "dem/neighbours.hpp"
 #include "dem/step.hpp"
 #include "mesh/die.hpp"
+#include "mesh/exact.hpp"
 #include "mesh/shapes.hpp"
 
 namespace app {
@@ -76,8 +77,9 @@ ShoePlan plan_shoe(const PipelineScene& s, const mesh::Box& die_box, double tabl
 
 // Upper bound of the radius of the largest sphere the cavity holds below the table: the distance
 // to the die is 1-Lipschitz, so the true maximum exceeds the sampled one by at most half a grid
-// diagonal. Distances beyond the field's band read as the band.
-double largest_inscribed_radius_bound(const mesh::WallField& die, const mesh::Box& cavity, double table_z, double spacing) {
+// diagonal. Beyond the field's band, which reads as the band there, the exact distance.
+double largest_inscribed_radius_bound(const mesh::WallField& die, const mesh::ExactSurface& exact, const mesh::Box& cavity,
+                                      double table_z, double spacing) {
   const Vec3 size = cavity.size();
   spacing = std::max(spacing, size.maxCoeff() / 64);
   const int nx = int(size.x() / spacing) + 1, ny = int(size.y() / spacing) + 1, nz = int((table_z - cavity.lo.z()) / spacing) + 1;
@@ -85,8 +87,11 @@ double largest_inscribed_radius_bound(const mesh::WallField& die, const mesh::Bo
 #pragma omp parallel for collapse(2) reduction(max : best) schedule(static)
   for (int i = 0; i < nx; ++i)
     for (int j = 0; j < ny; ++j)
-      for (int k = 0; k < nz; ++k)
-        best = std::max(best, die.signed_distance(cavity.lo + spacing * Vec3(i + 0.5, j + 0.5, k + 0.5)));
+      for (int k = 0; k < nz; ++k) {
+        const Vec3 p = cavity.lo + spacing * Vec3(i + 0.5, j + 0.5, k + 0.5);
+        const double near = die.signed_distance(p);
+        best = std::max(best, near >= die.free_band ? exact.distance(p) : near);
+      }
   return best + 0.5 * std::sqrt(3.0) * spacing;
 }
 
@@ -147,9 +152,14 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
   const double spread = s.diameter_spread;
 
   // 1. The die: cavity, tool and SDF over a table as long as the shoe's travel.
-  mesh::DieOptions die_options = mesh::die_options_for_grains(0.5 * diameter * (1 + spread), 0.25 * diameter * (1 + spread));
-  die_options.unit = mesh::parse_unit(s.die_units, "die.units");
-  die_options.role = mesh::parse_role(s.die_role, "die.role");
+  const auto die_options_for = [&](double grain_diameter) {
+    const double r = 0.5 * grain_diameter * (1 + spread);
+    mesh::DieOptions o = mesh::die_options_for_grains(r, 0.5 * r, s.die_voxel_fraction * r);
+    o.unit = mesh::parse_unit(s.die_units, "die.units");
+    o.role = mesh::parse_role(s.die_role, "die.role");
+    return o;
+  };
+  mesh::DieOptions die_options = die_options_for(diameter);
   if (die_options.role != mesh::WallRole::cavity)
     throw InputError(die_mesh.string(), "die.role", "the pipeline fills a cavity", "Give the cavity mesh (role \"cavity\")");
   const mesh::ImportResult preview = mesh::import_mesh(die_mesh, {die_options.unit});
@@ -167,8 +177,7 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
                        s.coarse_graining * scale, s.coarse_graining);
     diameter *= scale;
     estimate = double(s.max_grains);
-    die_options = mesh::die_options_for_grains(0.5 * diameter * (1 + spread), 0.25 * diameter * (1 + spread));
-    die_options.unit = mesh::parse_unit(s.die_units, "die.units");
+    die_options = die_options_for(diameter);
   }
   const double r_max = 0.5 * diameter * (1 + spread);
   plan.motion.start_position.z() = table_z + s.clearance * r_max;
@@ -199,7 +208,7 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
   auto die_field = std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid));
   // Grains too coarse for the cavity: refused when none can enter it; warned when it is narrower
   // than a few grains, where the wall layer is most of the part (PHYSICS.md §4).
-  const double inscribed = largest_inscribed_radius_bound(*die_field, box, table_z, 0.1 * r_max);
+  const double inscribed = largest_inscribed_radius_bound(*die_field, mesh::ExactSurface(die.solid), box, table_z, 0.1 * r_max);
   if (inscribed < r_max)
     throw InputError(die_mesh.string(), "powder.coarse_graining",
                      fmt::format("grains up to {:.3g} mm across cannot enter the cavity: the largest sphere it holds is at most "
@@ -211,7 +220,7 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
                        "there is mostly wall layer; lower powder.coarse_graining",
                        die.name, 2 * inscribed * 1e3, diameter * 1e3);
 
-  dem::ModelSpec spec = s.spec;
+  dem::ModelSpec spec = coarse_grained_spec(s.spec, diameter / s.particle_diameter);
   // The collision time must resolve the fastest impact: a grain falling the die's depth onto the
   // floor, plus the shoe's speed.
   const double impact = std::sqrt(2 * spec.gravity.norm() * box.size().z()) + s.speed;

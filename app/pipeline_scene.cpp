@@ -40,6 +40,12 @@ int material_named(const dem::ModelSpec& spec, const std::string& name) {
   throw diefill::InputError("scene", "materials", "has no material named \"" + name + "\"", "Define it");
 }
 
+dem::ModelSpec coarse_grained_spec(const dem::ModelSpec& spec, double alpha) {
+  dem::ModelSpec scaled = spec;
+  scaled.linear_stiffness *= alpha;
+  return scaled;
+}
+
 PipelineScene load_pipeline_scene(const std::optional<std::filesystem::path>& scene_file,
                                   const std::vector<std::string>& overrides) {
   PipelineScene s;
@@ -57,6 +63,10 @@ PipelineScene load_pipeline_scene(const std::optional<std::filesystem::path>& sc
     if (auto f = t->string("file")) s.die = base / *f;
     s.die_units = t->string("units").value_or(s.die_units);
     s.die_role = t->string("role").value_or(s.die_role);
+    s.die_voxel_fraction = t->number("voxel_fraction", s.die_voxel_fraction);
+    if (!(s.die_voxel_fraction > 0) || s.die_voxel_fraction > 4)
+      t->fail("voxel_fraction", "must lie in (0, 4] [largest grain radii]",
+              "Coarser voxels let grains through thin features; 0.25 is the default");
     t->finish();
   }
   if (auto t = root.table("shoe")) {
@@ -156,7 +166,8 @@ std::string describe(const PipelineScene& s) {
   out += "[die]\n";
   out += fmt::format("file = \"{}\"\n", s.die.string());
   out += fmt::format("units = \"{}\"\n", s.die_units);
-  out += fmt::format("role = \"{}\"            # the mesh is the part's shape, open at the die table (its highest z)\n\n", s.die_role);
+  out += fmt::format("role = \"{}\"            # the mesh is the part's shape, open at the die table (its highest z)\n", s.die_role);
+  out += fmt::format("voxel_fraction = {}       # SDF voxel edge in largest grain radii: contacts are exact either way, finer voxels find them faster near curved walls\n\n", s.die_voxel_fraction);
   out += "[shoe]                      # the seed study's box shoe, open at the bottom\n";
   out += fmt::format("length = {}              # [m] inside, along the motion (x)\n", s.shoe_length);
   out += fmt::format("width = {}                # [m] inside, across the motion (y)\n", s.shoe_width);
@@ -187,7 +198,9 @@ std::string describe(const PipelineScene& s) {
   out += fmt::format("normal = \"{}\"\n", law(s.spec.normal, {"hertz", "linear"}));
   out += fmt::format("tangential = \"{}\"\n", law(s.spec.tangential, {"mindlin", "none"}));
   out += fmt::format("rolling = \"{}\"            # spheres need rolling resistance for 30-40° repose angles\n", law(s.spec.rolling, {"epsd", "cdt", "none"}));
-  out += fmt::format("cohesion = \"{}\"\n\n", law(s.spec.cohesion, {"sjkr", "none"}));
+  out += fmt::format("cohesion = \"{}\"\n", law(s.spec.cohesion, {"sjkr", "none"}));
+  out += fmt::format("linear_stiffness = {}      # [N/m] the real powder's, for the linear law; coarse grains get α times it\n\n",
+                     s.spec.linear_stiffness);
   auto material = [&](const dem::Material& m, const char* why_e) {
     out += "[[materials]]\n";
     out += fmt::format("name = \"{}\"\n", m.name);

@@ -19,6 +19,7 @@ struct PipelineScene {
   std::filesystem::path die;  // mesh
   std::string die_units = "mm";
   std::string die_role = "cavity";
+  double die_voxel_fraction = 0.25;  // SDF voxel edge [largest grain radii] (mesh::default_voxel_fraction)
   // [shoe] (metres)
   double shoe_length = 32e-3, shoe_width = 50e-3, shoe_height = 37e-3, shoe_wall = 3e-3;
   double fill_height = 8e-3;    // powder height in the shoe
@@ -59,6 +60,10 @@ PipelineScene load_pipeline_scene(const std::optional<std::filesystem::path>& sc
                                   const std::vector<std::string>& overrides);
 // Index of the material `name` ("powder", "steel"); InputError when the scene lacks it.
 int material_named(const dem::ModelSpec& spec, const std::string& name);
+// The contact laws for grains `alpha` times the real powder's size (PHYSICS.md §4). Hertz,
+// damping to a restitution, rolling and SJKR cohesion scale by themselves; a linear spring must
+// stiffen as α, since contact.linear_stiffness is given for the real powder.
+dem::ModelSpec coarse_grained_spec(const dem::ModelSpec& spec, double alpha);
 // The fully resolved scene as TOML, every key with its value and the reason for its default.
 std::string describe(const PipelineScene& scene);
 

@@ -16,6 +16,14 @@ void discharge(const PipelineScene& scene, bool reduced, Output& out);
 // correlation for comparison.
 void repose(const PipelineScene& scene, bool reduced, Output& out);
 
+// Invariance under coarse graining: slot flow, outflow angle and the ring die's fill density at
+// three grain sizes, with the boundary corrections (Beverloo k·αd, the wall layer).
+void coarse_graining(const PipelineScene& scene, bool reduced, Output& out);
+
+// The ring die's density-field error against wall-clock time, sweeping grain size, stiffness,
+// time step and wall voxels: the Pareto front and the best settings for three time budgets.
+void speed_accuracy(const PipelineScene& scene, bool reduced, Output& out);
+
 // Where each method fails (time step, wall voxels, shoe speed against the skin, grains too
 // coarse for the cavity): each probed, and whether the stability checks caught it.
 void stability(const PipelineScene& scene, bool reduced, Output& out);

@@ -38,14 +38,12 @@ Sizes sizes(bool reduced) {
 struct BeverlooFit {
   double a = 0, k = 0, a_error = 0, k_error = 0;
   double rms_relative_residual = 0;
-  double rate(double length, double width, double d) const {
-    return a * std::max(0.0, length - k * d) * std::pow(std::max(0.0, width - k * d), 1.5);
-  }
+  double rate(double length, double width, double d) const { return a * beverloo_slot(length, width, k, d); }
 };
 
 BeverlooFit fit_beverloo(const std::vector<double>& width, const std::vector<double>& rate, double length, double d) {
   const std::size_t n = width.size();
-  const auto shape = [&](double k, std::size_t i) { return (length - k * d) * std::pow(width[i] - k * d, 1.5); };
+  const auto shape = [&](double k, std::size_t i) { return beverloo_slot(length, width[i], k, d); };
   const auto best_a = [&](double k) {
     double fw = 0, ff = 0;
     for (std::size_t i = 0; i < n; ++i) fw += shape(k, i) * rate[i], ff += shape(k, i) * shape(k, i);
@@ -117,11 +115,7 @@ void discharge(const PipelineScene& scene, bool reduced, Output& out) {
     c.fill_height = z.fill_height * d;
     c.flow_time = z.flow_time;
     const SlotRun run = run_slot_container(powder, c, fmt::format("discharge: slot {:.3g} mm", c.slot_width * 1e3));
-    // Steady flow: after the opening transient (50 ms) and before the bed has lost 40 %.
-    std::vector<double> t, m;
-    for (std::size_t i = 0; i < run.time.size(); ++i)
-      if (run.time[i] >= 0.05 && run.discharged[i] <= 0.4 * run.initial_mass) t.push_back(run.time[i]), m.push_back(run.discharged[i]);
-    const LineFit flow = fit_line(t, m);
+    const LineFit flow = steady_rate(run);
     if (flow.points < 5)
       diefill::log::warn("discharge: slot {:.3g} mm: only {} samples of steady flow", c.slot_width * 1e3, flow.points);
     widths.push_back(c.slot_width);

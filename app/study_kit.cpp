@@ -6,6 +6,7 @@
 
 #include "app/density_stage.hpp"
 #include "dem/step.hpp"
+#include "mesh/import.hpp"
 #include "mesh/sdf.hpp"
 #include "mesh/shapes.hpp"
 
@@ -16,7 +17,7 @@ using dem::Vec3;
 
 Powder powder_of(const PipelineScene& scene) {
   Powder p;
-  p.spec = scene.spec;
+  p.spec = coarse_grained_spec(scene.spec, scene.coarse_graining);
   p.powder = material_named(scene.spec, "powder");
   p.wall = material_named(scene.spec, "steel");
   p.diameter = scene.grain_diameter();
@@ -30,6 +31,15 @@ Powder powder_of(const PipelineScene& scene) {
 dem::MeshWall block_wall(const Vec3& lo, const Vec3& hi, double r_max, int material, const std::string& name) {
   return dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(mesh::contact_wall_field(mesh::box_solid(lo, hi), r_max)),
                               material, name);
+}
+
+std::filesystem::path ring_mesh(const std::filesystem::path& work) {
+  const std::filesystem::path ring = work / "ring.stl";
+  if (!std::filesystem::exists(ring)) {
+    std::filesystem::create_directories(work);
+    mesh::write_stl(mesh::bundled_die("ring"), ring, mesh::LengthUnit::mm, "diefill ring die");
+  }
+  return ring;
 }
 
 std::size_t add_grains(dem::State& state, const dem::InsertRegion& region, const Powder& powder, std::size_t count,

@@ -37,6 +37,10 @@ Powder powder_of(const PipelineScene& scene);
 // An axis-aligned solid block [lo, hi] as a wall at rest.
 dem::MeshWall block_wall(const dem::Vec3& lo, const dem::Vec3& hi, double r_max, int material, const std::string& name);
 
+// The bundled ring die (annulus from Ø10 to Ø20 mm, 10 mm deep), written once into `work`.
+inline constexpr double ring_inner_radius = 5e-3, ring_outer_radius = 10e-3, ring_depth = 10e-3;  // [m]
+std::filesystem::path ring_mesh(const std::filesystem::path& work);
+
 // Drops up to `count` of the powder's grains, clear of each other and of the grains present,
 // into `region` (loosely: below 0.45 solid fraction of its box); returns how many fitted.
 std::size_t add_grains(dem::State& state, const dem::InsertRegion& region, const Powder& powder, std::size_t count,

@@ -71,9 +71,8 @@ void repose(const PipelineScene& scene, bool reduced, Output& out) {
     std::filesystem::create_directories(out.work());
     dem::write_vtu(h.state, out.work() / ("heap_" + tag + ".vtu"));
     dem::write_vtu(o.state, out.work() / ("outflow_" + tag + ".vtu"));
-    const SurfaceFit left = fit_outflow_surface(o.state, drain, d, -1), right = fit_outflow_surface(o.state, drain, d, +1);
-    const double outflow = 0.5 * (left.angle_deg + right.angle_deg);
-    const double outflow_error = 0.5 * std::hypot(left.angle_error_deg, right.angle_error_deg);
+    const OutflowAngle outflow_fit = outflow_angle(o.state, drain, d, 2 * d);
+    const double outflow = outflow_fit.angle_deg, outflow_error = outflow_fit.error_deg;
     // The heap's base is coated with the powder (study_scenes.hpp): its friction is the grains'.
     const double zhou = zhou_angle(f.sliding, f.sliding, f.rolling * 0.25 * d * 1e3, f.rolling * 0.5 * d * 1e3, d * 1e3);
     diefill::log::info("{}: heap {:.1f}° ± {:.1f}°, outflow {:.1f}° ± {:.1f}°, Zhou {:.1f}°", label, heap_fit.angle_deg,
@@ -87,7 +86,7 @@ void repose(const PipelineScene& scene, bool reduced, Output& out) {
                     {"heap_grains", h.on_pedestal},
                     {"outflow_angle_deg", outflow},
                     {"outflow_angle_error_deg", outflow_error},
-                    {"outflow_sides_deg", {left.angle_deg, right.angle_deg}},
+                    {"outflow_sides_deg", {outflow_fit.left_deg, outflow_fit.right_deg}},
                     {"zhou_angle_deg", zhou}});
   }
   out.table("repose.csv",

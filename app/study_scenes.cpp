@@ -122,6 +122,17 @@ SlotRun run_slot_container(const Powder& p, const SlotContainer& c, const std::s
   return run;
 }
 
+double beverloo_slot(double length, double width, double k, double d) {
+  return std::max(0.0, length - k * d) * std::pow(std::max(0.0, width - k * d), 1.5);
+}
+
+LineFit steady_rate(const SlotRun& run) {
+  std::vector<double> t, m;
+  for (std::size_t i = 0; i < run.time.size(); ++i)
+    if (run.time[i] >= 0.05 && run.discharged[i] <= 0.4 * run.initial_mass) t.push_back(run.time[i]), m.push_back(run.discharged[i]);
+  return fit_line(t, m);
+}
+
 HeapRun run_heap(const Powder& p, const Heap& h, const std::string& label) {
   const double r = p.r_max(), d = p.diameter, base = 4 * d;
   dem::ModelSpec spec = p.spec;
@@ -171,9 +182,8 @@ HeapRun run_heap(const Powder& p, const Heap& h, const std::string& label) {
   return run;
 }
 
-SurfaceFit fit_outflow_surface(const dem::State& s, const SlotContainer& c, double d, int side) {
-  // Columns one grain wide from the slot's edge to the end wall; two grains kept clear of each.
-  const double from = 0.5 * c.slot_width + 2 * d, to = 0.5 * c.length - 2 * d;
+SurfaceFit fit_outflow_surface(const dem::State& s, const SlotContainer& c, double d, int side, double clear) {
+  const double from = 0.5 * c.slot_width + clear, to = 0.5 * c.length - clear;
   const auto count = std::size_t(std::max(0.0, std::floor((to - from) / d)));
   const std::vector<double> top = column_tops(s, count, [&](const Vec3& x) {
     if (x.z() < 0 || x.x() * side <= 0) return -1L;
@@ -182,6 +192,12 @@ SurfaceFit fit_outflow_surface(const dem::State& s, const SlotContainer& c, doub
   std::vector<double> position(count);
   for (std::size_t k = 0; k < count; ++k) position[k] = from + (double(k) + 0.5) * d;
   return fit_surface(position, top);
+}
+
+OutflowAngle outflow_angle(const dem::State& s, const SlotContainer& c, double d, double clear) {
+  const SurfaceFit left = fit_outflow_surface(s, c, d, -1, clear), right = fit_outflow_surface(s, c, d, +1, clear);
+  return {0.5 * (left.angle_deg + right.angle_deg), 0.5 * std::hypot(left.angle_error_deg, right.angle_error_deg),
+          left.angle_deg, right.angle_deg};
 }
 
 SurfaceFit fit_heap_surface(const dem::State& s, const Heap& h, double d) {

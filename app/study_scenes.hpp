@@ -31,6 +31,11 @@ struct SlotRun {
 };
 
 SlotRun run_slot_container(const Powder& powder, const SlotContainer& container, const std::string& label);
+// The Beverloo slot law's geometry (L - k d)(b - k d)^{3/2} [m^{5/2}]: the rate over C_s rho_b sqrt(g).
+double beverloo_slot(double length, double width, double k, double d);
+// The steady discharge rate [kg/s]: a line through the discharged mass after the opening's
+// transient (50 ms) and before the bed has lost 40 % (its head then drops).
+LineFit steady_rate(const SlotRun& run);
 
 struct Heap {
   double pedestal_radius = 0;  // [m]
@@ -54,8 +59,15 @@ struct SurfaceFit {
   double angle_deg = 0, angle_error_deg = 0;
   std::vector<double> position, height;  // the columns used [m]
 };
-// Columns along |x| on one side of the slot (side = -1 or +1) in the drained container.
-SurfaceFit fit_outflow_surface(const dem::State& state, const SlotContainer& container, double diameter, int side);
+// Columns one grain wide along |x| on one side of the slot (side = -1 or +1) in the drained
+// container, `clear` [m] kept clear of the slot's edge and of the end wall.
+SurfaceFit fit_outflow_surface(const dem::State& state, const SlotContainer& container, double diameter, int side,
+                               double clear);
+// The outflow angle: the mean of both sides' fits, with its standard error.
+struct OutflowAngle {
+  double angle_deg = 0, error_deg = 0, left_deg = 0, right_deg = 0;
+};
+OutflowAngle outflow_angle(const dem::State& state, const SlotContainer& container, double diameter, double clear);
 // Columns along the radius of the heap.
 SurfaceFit fit_heap_surface(const dem::State& state, const Heap& heap, double diameter);
 

@@ -106,16 +106,6 @@ std::string time_step_run(const Powder& powder, double fraction) {
   return settled_result_problems(state, 0.05);
 }
 
-// The bundled ring die (annulus 5 mm wide, 10 mm deep), written once into the work folder.
-std::filesystem::path ring_mesh(const std::filesystem::path& work) {
-  const std::filesystem::path ring = work / "ring.stl";
-  if (!std::filesystem::exists(ring)) {
-    std::filesystem::create_directories(work);
-    mesh::write_stl(mesh::bundled_die("ring"), ring, mesh::LengthUnit::mm, "diefill ring die");
-  }
-  return ring;
-}
-
 std::string voxel_run(const Powder& powder, double voxel_over_radius, const std::filesystem::path& work) {
   const double r = powder.r_max();
   const std::filesystem::path ring = ring_mesh(work);

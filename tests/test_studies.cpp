@@ -1,10 +1,12 @@
-// The reduced studies (`diefill study NAME --reduced`, 1.6 mm grains): each runs end to end and
+// The reduced studies (`diefill study NAME --reduced`, 1.6 mm grains unless a test says
+// otherwise): each runs end to end and
 // checks the law it is about. Tolerances are statistical (two standard errors of the study's own
 // fits) or come from PHYSICS.md's stated ranges; each says which.
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <map>
 
@@ -17,14 +19,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-nlohmann::json run_reduced(const std::string& name) {
+nlohmann::json run_reduced(const std::string& name, std::vector<std::string> overrides = {"powder.coarse_graining=16"}) {
   const fs::path out = fs::temp_directory_path() / fmt::format("diefill-study-{}-{}", name, ::getpid());
   fs::remove_all(out);
   app::StudyCommand c;
   c.name = name;
   c.reduced = true;
   c.out = out;
-  c.overrides = {"powder.coarse_graining=16"};
+  c.overrides = std::move(overrides);
   EXPECT_EQ(app::run_study(c), 0);
   std::ifstream in(out / name / (name + ".json"));
   return nlohmann::json::parse(in);
@@ -57,6 +59,60 @@ TEST(Study, DischargeFollowsTheBeverlooSlotLawAndTheCriticalVelocityLaw) {
   EXPECT_TRUE(consistent_with(critical["n"], critical["n_error"], 1.0, 2.0)) << critical.dump();
   EXPECT_GT(critical["v_c_m_s"].get<double>(), 0.0);
   EXPECT_LT(critical["v_c_m_s"].get<double>(), shoe["speeds_m_s"][1].get<double>());
+}
+
+// Coarse graining (PHYSICS.md §4) at grains of 0.8, 1.13 and 1.6 mm in one slot container (the
+// coarsest five grains across its slot and its length) and the ring die.
+TEST(Study, CoarseGrainingKeepsFlowAndReposeOnceTheBoundaryIsCorrected) {
+  const nlohmann::json r = run_reduced("coarse-graining", {});
+  const auto& inv = r["invariance"];
+  // The slot's k·αd term is large here: uncorrected, the rates differ by far more than 5 %;
+  // corrected with k = 1.5 (PHYSICS.md §3), they meet the seed study's 5 %.
+  EXPECT_GT(inv["flow_rate_spread"]["measured"].get<double>(), 0.05) << inv.dump();
+  EXPECT_LT(inv["flow_rate_spread_beverloo_corrected"]["measured"].get<double>(), 0.05) << inv.dump();
+  // And the k that makes the three rates one law is a Beverloo k for spheres (1.4-2.9).
+  const double k = r["settings"]["beverloo_k_that_makes_the_rates_one_law"];
+  EXPECT_GE(k, 1.4);
+  EXPECT_LE(k, 2.9);
+  // Outflow angles within the seed study's 2°, allowing two standard errors of the extreme pair.
+  std::vector<std::pair<double, double>> angles;
+  for (const auto& f : r["factors"]) angles.push_back({f["slot"]["outflow_angle_deg"], f["slot"]["outflow_angle_error_deg"]});
+  const auto [low, high] = std::minmax_element(angles.begin(), angles.end());
+  EXPECT_LE(high->first - low->first, 2.0 + 2 * std::hypot(high->second, low->second)) << inv.dump();
+  // Not asserted: the ring's fill density. Its annulus is 3 to 6 of these grains wide, far from
+  // the 20 PHYSICS.md §4 asks for; the study reports the spread (about 4 %) and why.
+}
+
+// The speed-accuracy sweep on the ring die (1.6 mm grains): the cost laws it rests on, read
+// from step counts, not timings (PHYSICS.md §4-5).
+TEST(Study, SpeedAccuracySweepFollowsTheCostLaws) {
+  const nlohmann::json r = run_reduced("speed-accuracy");
+  std::map<std::string, nlohmann::json> run;
+  for (const auto& x : r["runs"]) {
+    run[x["label"]] = x;
+    if (!x["ran"].get<bool>()) {
+      EXPECT_FALSE(x["stopped_by"].get<std::string>().empty()) << x.dump();
+    }
+  }
+  const auto& reference = run.at("the scene's settings");
+  ASSERT_TRUE(reference["ran"].get<bool>());
+  // Grains √2 coarser: N as α⁻³ and the step as α, so particle-steps as α⁻⁴; the shoe's grain
+  // count and the step's Hertz limit make it approximate: within ±0.5 in the exponent.
+  const auto& coarser = run.at("grains √2 coarser");
+  const double exponent = std::log(coarser["particle_steps"].get<double>() / reference["particle_steps"].get<double>()) /
+                          std::log(coarser["coarse_graining"].get<double>() / reference["coarse_graining"].get<double>());
+  EXPECT_NEAR(exponent, -4.0, 0.5);
+  // The step: twice the fraction gives exactly twice the step; a tenth of the stiffness a step
+  // between 10^0.4 (Hertz-limited) and 10^0.5 (Rayleigh-limited) times longer.
+  const double dt = reference["time_step_s"];
+  EXPECT_NEAR(run.at("time step x 2")["time_step_s"].get<double>() / dt, 2.0, 1e-9);
+  const double softened = run.at("stiffness / 10")["time_step_s"].get<double>() / dt;
+  EXPECT_GE(softened, std::pow(10.0, 0.4) * (1 - 1e-9));
+  EXPECT_LE(softened, std::pow(10.0, 0.5) * (1 + 1e-9));
+  // Another seed changes the field (the noise floor is not zero) but not the fill by much.
+  EXPECT_GT(r["noise_floor_field_error"].get<double>(), 0.0);
+  EXPECT_LT(run.at("the same, another seed")["fill_ratio_error"].get<double>(), 0.05);
+  EXPECT_EQ(r["budgets"].size(), 3u);
 }
 
 // Each method probed below and beyond its limit: below, the run passes its checks and its
