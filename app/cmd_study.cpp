@@ -24,7 +24,8 @@ const std::map<std::string, StudyFunction>& studies() {
       {"repose", study::repose},
       {"stability", study::stability},
       {"coarse-graining", study::coarse_graining},
-      {"speed-accuracy", study::speed_accuracy}};
+      {"speed-accuracy", study::speed_accuracy},
+      {"cross-validation", study::cross_validation}};
   return table;
 }
 

@@ -24,6 +24,10 @@ void coarse_graining(const PipelineScene& scene, bool reduced, Output& out);
 // time step and wall voxels: the Pareto front and the best settings for three time budgets.
 void speed_accuracy(const PipelineScene& scene, bool reduced, Output& out);
 
+// Rolling friction calibrated on the outflow angle predicts the slot flow, and the reverse; the
+// scene's powder with another seed stands for the measured one.
+void cross_validation(const PipelineScene& scene, bool reduced, Output& out);
+
 // Where each method fails (time step, wall voxels, shoe speed against the skin, grains too
 // coarse for the cavity): each probed, and whether the stability checks caught it.
 void stability(const PipelineScene& scene, bool reduced, Output& out);

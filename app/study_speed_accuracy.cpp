@@ -120,7 +120,9 @@ void speed_accuracy(const PipelineScene& scene, bool reduced, Output& out) {
       const DensityResult field = compute_density(grains, die, walls, material_density, density, run.dir.string());
       r.field = field.field.corrected.solid_fraction;
       cavity = field.field.cavity;
-    } catch (const diefill::StabilityError& e) {
+    } catch (const std::runtime_error& e) {
+      // A setting the checks stop or refuse is a result of the sweep (StabilityError, InputError);
+      // the reference's own failure ends the study below.
       r.seconds = clock.seconds();
       r.stopped = e.what();
       diefill::log::warn("speed-accuracy: {}: stopped: {}", setting.label, e.what());

@@ -115,6 +115,28 @@ TEST(Study, SpeedAccuracySweepFollowsTheCostLaws) {
   EXPECT_EQ(r["budgets"].size(), 3u);
 }
 
+// Cross-validation (1.6 mm grains): calibrated on the outflow angle, the rolling friction comes
+// out as the scene's and predicts the flow rate; calibrated on the flow rate, it predicts the
+// angle. Agreement means within two combined standard errors (the observation's and the maps'
+// scatter, propagated through the calibration).
+TEST(Study, CrossValidationPredictsFlowFromReposeAndReposeFromFlow) {
+  const nlohmann::json r = run_reduced("cross-validation");
+  const auto& angle_map = r["maps"]["angle_deg"];
+  // The angle rises with rolling friction (Zhou et al.'s trend), clearly: else nothing calibrates.
+  EXPECT_GT(angle_map["slope"].get<double>(), 2 * angle_map["slope_error"].get<double>()) << angle_map.dump();
+  const auto& on_angle = r["calibrated_on_angle"];
+  EXPECT_NEAR(on_angle["rolling_friction"].get<double>(), r["true_rolling_friction"].get<double>(),
+              2 * on_angle["rolling_friction_error"].get<double>())
+      << on_angle.dump();
+  for (const char* direction : {"calibrated_on_angle", "calibrated_on_flow"}) {
+    const auto& c = r[direction];
+    const auto& p = c.contains("rate_kg_s") ? c["rate_kg_s"] : c["angle_deg"];
+    EXPECT_NEAR(p["predicted"].get<double>(), p["observed"].get<double>(),
+                2 * std::hypot(p["predicted_error"].get<double>(), p["observed_error"].get<double>()))
+        << direction << ": " << c.dump();
+  }
+}
+
 // Each method probed below and beyond its limit: below, the run passes its checks and its
 // result is right; beyond, a check stops or refuses it. No run may end wrong and unnoticed.
 TEST(Study, StabilityMapCatchesEveryFailure) {
