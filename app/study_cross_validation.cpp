@@ -79,13 +79,7 @@ void cross_validation(const PipelineScene& scene, bool reduced, Output& out) {
   const Powder powder = powder_of(scene);
   const double d = powder.diameter;
   const double truth = powder.spec.materials[std::size_t(powder.powder)].rolling_friction;
-  SlotContainer c;
-  c.slot_width = 6 * d;
-  c.length = c.slot_width + 2 * (reduced ? 10 : 14) * d;
-  c.width = (reduced ? 6 : 8) * d;
-  c.fill_height = (reduced ? 12 : 16) * d;
-  c.flow_time = 1.5;
-  c.stop_when_drained = true;
+  const SlotContainer c = outflow_container(d, reduced);
 
   const std::vector<double> sweep = reduced ? std::vector<double>{0.0, 0.1, 0.2, 0.3} : std::vector<double>{0.0, 0.05, 0.1, 0.15, 0.2, 0.3};
   std::vector<Point> map;

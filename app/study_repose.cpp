@@ -47,14 +47,7 @@ void repose(const PipelineScene& scene, bool reduced, Output& out) {
   heap.pour_rate = double(heap.grains) / 0.6;
   heap.drop_height = 2 * d;
   heap.stream_radius = 3 * d;
-  SlotContainer drain;
-  drain.slot_width = 6 * d;
-  drain.length = drain.slot_width + 2 * (reduced ? 10 : 14) * d;
-  drain.width = (reduced ? 6 : 8) * d;
-  drain.fill_height = (reduced ? 12 : 16) * d;
-  drain.flow_time = 1.5;
-  drain.sample_every = 0.01;
-  drain.stop_when_drained = true;
+  const SlotContainer drain = outflow_container(d, reduced);
 
   std::vector<std::vector<nlohmann::json>> rows;
   nlohmann::json runs = nlohmann::json::array();

@@ -59,6 +59,17 @@ SurfaceFit fit_surface(std::vector<double> position, std::vector<double> height)
 
 }  // namespace
 
+SlotContainer outflow_container(double d, bool reduced) {
+  SlotContainer c;
+  c.slot_width = 6 * d;
+  c.length = c.slot_width + 2 * (reduced ? 10 : 14) * d;
+  c.width = (reduced ? 6 : 8) * d;
+  c.fill_height = (reduced ? 12 : 16) * d;
+  c.flow_time = 1.5;
+  c.stop_when_drained = true;
+  return c;
+}
+
 SlotRun run_slot_container(const Powder& p, const SlotContainer& c, const std::string& label) {
   const double r = p.r_max(), d = p.diameter;
   const double half_l = 0.5 * c.length, half_w = 0.5 * c.width, floor = 2 * r;

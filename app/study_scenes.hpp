@@ -22,6 +22,10 @@ struct SlotContainer {
   bool stop_when_drained = false;                 // end early once no grain has left for 0.1 s
 };
 
+// The container whose drained slopes give the outflow angle (and, while it drains, a flow rate):
+// a slot 6 grains wide, 10 (reduced) or 14 grains of floor beside it, run until no grain leaves.
+SlotContainer outflow_container(double diameter, bool reduced);
+
 struct SlotRun {
   std::vector<double> time, discharged;  // since the opening [s]; mass below the floor or gone [kg]
   double bulk_density = 0;               // of the settled bed [kg/m³]
