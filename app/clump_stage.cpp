@@ -8,12 +8,8 @@ namespace app {
 
 mesh::ClumpTemplate build_clump(const ClumpRequest& request) {
   const mesh::ImportResult imported = mesh::import_mesh(request.mesh, {request.unit});
-  const double size = mesh::bounding_box(imported.mesh).size().maxCoeff();
-  // Repair may move the surface by a tenth of the clump tolerance at most.
-  mesh::RepairOptions repair_options;
-  repair_options.tolerance_m = 0.1 * request.tolerance * size;
-  repair_options.max_hole_m = 0.05 * size;
-  const mesh::RepairResult repaired = mesh::repair(imported.mesh, repair_options, request.mesh.string());
+  const mesh::RepairResult repaired =
+      mesh::repair(imported.mesh, mesh::grain_repair_options(imported.mesh, request.tolerance), request.mesh.string());
   for (const std::string& action : repaired.actions) diefill::log::info("{}: {}", request.mesh.string(), action);
   mesh::ClumpOptions options;
   options.tolerance = request.tolerance;

@@ -11,7 +11,10 @@ TriMesh alpha_wrap(const TriMesh& soup, double alpha, double offset);
 
 // Largest distance from points sampled on `from` (a barycentric grid on each triangle, up to
 // 16 points along an edge) to the surface of `to` [m]: one side of the Hausdorff distance.
-double max_distance(const TriMesh& from, const TriMesh& to);
+// With `outside_target`, only points outside the closed solid `to` count: faces buried in it
+// (inner lobes of a fold) bound no part of it, wherever they lie.
+enum class Samples { all, outside_target };
+double max_distance(const TriMesh& from, const TriMesh& to, Samples samples = Samples::all);
 
 // Pairs of intersecting triangles that share no vertex; 0 for a clean mesh.
 std::size_t count_self_intersections(const TriMesh& mesh);
@@ -20,9 +23,18 @@ std::size_t count_self_intersections(const TriMesh& mesh);
 
 namespace mesh::detail {
 
-// Union of closed shells that intersect each other but not themselves (a gear set in mesh,
-// engravings on a disc), by CGAL corefinement: exact, no tolerance spent. Returns false when a
-// shell is open or intersects itself, or a union step fails; then `out` is unspecified.
-bool union_of_shells(const TriMesh& closed_shells, TriMesh& out);
+struct UnionResult {
+  TriMesh mesh;
+  double moved_m = 0;               // largest distance a fold's removal moved its shell [m]
+  std::size_t empty_shells = 0;     // closed shells enclosing no volume, dropped
+  std::size_t unfolded_shells = 0;  // shells whose self-intersections were re-meshed
+};
+
+// Union of the solids closed shells enclose, by CGAL corefinement: shells that intersect each
+// other (a gear set in mesh, engravings on a disc) are united exactly, no tolerance spent; a
+// shell folded through itself (a decimated scan) is first re-meshed locally where it folds
+// (`moved_m` says how far). Returns false when a shell is open or degenerate, a fold cannot be
+// removed, or a union step fails; then `out` is unspecified.
+bool union_of_shells(const TriMesh& closed_shells, UnionResult& out);
 
 }  // namespace mesh::detail

@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <unordered_map>
 
 #include "core/error.hpp"
@@ -224,6 +225,19 @@ RepairResult repair(const TriMesh& input, const RepairOptions& options, const st
                      fmt::format("{} triangle(s) cannot enclose a solid", before.triangles),
                      "Export the closed solid of the part, not a single face");
 
+  // A consistently oriented closed surface whose faces all point inward bounds the space around
+  // a solid. Whether the file means that solid or its complement (a cavity exported as the tool
+  // around it) cannot be told from the file, and the two give opposite dies: refuse rather than
+  // guess. A surface only partly flipped is an export glitch with one evident reading: it is
+  // re-oriented below.
+  if (before.orientation == "inward")
+    throw InputError(source, "orientation",
+                     fmt::format("every face points inward: the surface is inside out (signed volume "
+                                 "{:.6g} mm³), so it bounds the space around a solid, not the solid",
+                                 before.volume_m3 * 1e9),
+                     "Reverse the faces' winding in CAD or a mesh tool (MeshLab: Filters > Normals > "
+                     "Invert Faces Orientation) and export it again");
+
   // 1. Soup level: merge duplicate points, drop triangles with repeated vertices, and keep one
   //    of each duplicated triangle (either winding: double-sided surfaces become single).
   std::vector<Point> points;
@@ -277,15 +291,23 @@ RepairResult repair(const TriMesh& input, const RepairOptions& options, const st
   const bool closed = CGAL::is_closed(sm) && open_holes == 0;
   bool self_intersecting = closed && detail::count_self_intersections(repaired) > 0;
   bool geometry_changed = result.holes_filled > 0;
+  std::optional<double> union_moved_m;  // set when the shells were united
 
-  // 4. Closed shells that intersect each other (gears in mesh, engravings on a disc): their
-  //    exact union, which moves no surface that stays on the outside.
+  // 4. Closed shells that intersect each other or themselves (gears in mesh, engravings on a
+  //    disc, a folded scan): the union of the solids they enclose. The union itself moves no
+  //    surface that stays on the outside; removing a fold does, and is measured.
   if (closed && self_intersecting) {
-    TriMesh united;
+    detail::UnionResult united;
     if (detail::union_of_shells(repaired, united)) {
-      result.actions.push_back(fmt::format("united {} intersecting shells (exact corefinement)",
-                                           before.shells));
-      repaired = std::move(united);
+      if (united.empty_shells > 0)
+        result.actions.push_back(fmt::format("dropped {} shell(s) enclosing no volume", united.empty_shells));
+      result.actions.push_back(fmt::format("united {} intersecting shells (exact corefinement)", before.shells));
+      if (united.unfolded_shells > 0)
+        result.actions.push_back(fmt::format("re-meshed {} shell(s) folded through themselves ({} pairs of "
+                                             "intersecting triangles in the input), moving them by up to {}",
+                                             united.unfolded_shells, before.self_intersections, mm(united.moved_m)));
+      repaired = std::move(united.mesh);
+      union_moved_m = united.moved_m;
       sm.clear();
       std::vector<Point> pts;
       for (const Vec3& v : repaired.vertices) pts.push_back(to_point(v));
@@ -372,9 +394,12 @@ RepairResult repair(const TriMesh& input, const RepairOptions& options, const st
   }
 
   diefill::log::debug("repair: closed-surface checks done at {:.2f} s", clock.seconds());
-  if (geometry_changed) {
-    result.hausdorff_m = detail::max_distance(input, repaired);
+  if (geometry_changed || union_moved_m) {
     result.bridged_m = detail::max_distance(repaired, input);
+    // The union removes faces buried in the solid (a shell inside another, inner lobes), which
+    // measured against the result would read as moved by their depth: what it moved is what
+    // removing folds moved. Hole patches and a wrap are measured against the input.
+    result.hausdorff_m = union_moved_m ? *union_moved_m : detail::max_distance(input, repaired);
     if (result.hausdorff_m > options.tolerance_m)
       throw InputError(source, "tolerance",
                        fmt::format("repair would move the surface by up to {} ({}), more than the "
@@ -389,6 +414,14 @@ RepairResult repair(const TriMesh& input, const RepairOptions& options, const st
   result.after = inspect(result.mesh);
   result.repaired = !result.actions.empty();
   return result;
+}
+
+RepairOptions grain_repair_options(const TriMesh& grain, double clump_tolerance) {
+  const double size = bounding_box(grain).size().maxCoeff();
+  RepairOptions o;
+  o.tolerance_m = 0.1 * clump_tolerance * size;
+  o.max_hole_m = 0.1 * size;
+  return o;
 }
 
 std::string format_report(const MeshReport& r) {

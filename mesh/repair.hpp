@@ -35,6 +35,12 @@ struct RepairOptions {
   bool allow_wrap = true;         // fall back to alpha wrapping for what stays broken
 };
 
+// Repair limits for a grain mesh clumped at the relative `clump_tolerance`: repair may move
+// existing surface by a tenth of what the clump may deviate, and fills holes up to a tenth of
+// the grain's size (a missing face of a decimated scan; the report's `bridged` says how far a
+// patch reaches from the surface around it).
+RepairOptions grain_repair_options(const TriMesh& grain, double clump_tolerance);
+
 struct RepairResult {
   TriMesh mesh;  // closed, outward, without self-intersections
   MeshReport before, after;

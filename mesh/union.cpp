@@ -4,7 +4,9 @@
 #include <CGAL/Polygon_mesh_processing/connected_components.h>
 #include <CGAL/Polygon_mesh_processing/corefinement.h>
 #include <CGAL/Polygon_mesh_processing/orientation.h>
+#include <CGAL/Polygon_mesh_processing/measure.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/repair_self_intersections.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
 
@@ -24,7 +26,24 @@ using Point = K::Point_3;
 using SurfaceMesh = CGAL::Surface_mesh<Point>;
 namespace PMP = CGAL::Polygon_mesh_processing;
 
-bool union_in_this_process(const TriMesh& closed_shells, TriMesh& out) {
+TriMesh to_trimesh(const SurfaceMesh& sm) {
+  TriMesh out;
+  std::vector<int> index(sm.number_of_vertices() + sm.number_of_removed_vertices(), -1);
+  for (auto v : sm.vertices()) {
+    index[v.idx()] = int(out.vertices.size());
+    const Point& p = sm.point(v);
+    out.vertices.emplace_back(p.x(), p.y(), p.z());
+  }
+  for (auto f : sm.faces()) {
+    Triangle t{};
+    int k = 0;
+    for (auto v : CGAL::vertices_around_face(sm.halfedge(f), sm)) t[k++] = index[v.idx()];
+    out.triangles.push_back(t);
+  }
+  return out;
+}
+
+bool union_in_this_process(const TriMesh& closed_shells, UnionResult& out) {
   std::vector<Point> points;
   for (const Vec3& v : closed_shells.vertices) points.emplace_back(v.x(), v.y(), v.z());
   std::vector<std::array<std::size_t, 3>> faces;
@@ -36,12 +55,13 @@ bool union_in_this_process(const TriMesh& closed_shells, TriMesh& out) {
     return false;
   }
   PMP::polygon_soup_to_polygon_mesh(points, faces, all);
-  std::vector<SurfaceMesh> shells;
-  PMP::split_connected_components(all, shells);
-  for (SurfaceMesh& s : shells) {
-    if (!CGAL::is_closed(s) || PMP::does_self_intersect(s)) {
-      diefill::log::debug("union: a shell of {} faces is {}", s.number_of_faces(),
-                          CGAL::is_closed(s) ? "self-intersecting" : "open");
+  const double scale = mesh::bounding_box(closed_shells).size().maxCoeff();
+  std::vector<SurfaceMesh> split, shells;
+  PMP::split_connected_components(all, split);
+  out.moved_m = 0;
+  for (SurfaceMesh& s : split) {
+    if (!CGAL::is_closed(s)) {
+      diefill::log::debug("union: a shell of {} faces is open", s.number_of_faces());
       return false;
     }
     // Corefinement's other preconditions, unchecked in a release build of CGAL (a degenerate
@@ -52,8 +72,35 @@ bool union_in_this_process(const TriMesh& closed_shells, TriMesh& out) {
       diefill::log::debug("union: a shell has {} degenerate faces", degenerate.size());
       return false;
     }
+    // A shell that encloses nothing (two triangles back to back) adds nothing to the union.
+    if (std::abs(PMP::volume(s)) < 1e-9 * scale * scale * scale) {
+      ++out.empty_shells;
+      continue;
+    }
     if (!PMP::is_outward_oriented(s)) PMP::reverse_face_orientations(s);
+    // A shell folded through itself (a decimated scan): CGAL re-meshes the folds locally. That
+    // moves surface, measured here against the shell as it was.
+    if (PMP::does_self_intersect(s)) {
+      const TriMesh folded = to_trimesh(s);
+      if (!PMP::experimental::remove_self_intersections(s, CGAL::parameters::preserve_genus(false)) ||
+          PMP::does_self_intersect(s) || !CGAL::is_closed(s)) {
+        diefill::log::debug("union: the folds of a shell of {} faces could not be removed", s.number_of_faces());
+        return false;
+      }
+      out.moved_m = std::max(out.moved_m, max_distance(folded, to_trimesh(s), Samples::outside_target));
+      ++out.unfolded_shells;
+      // Re-meshing may part a fold into separate shells (an inner lobe): each joins the union.
+      std::vector<SurfaceMesh> parts;
+      PMP::split_connected_components(s, parts);
+      for (SurfaceMesh& part : parts) {
+        if (!PMP::is_outward_oriented(part)) PMP::reverse_face_orientations(part);
+        shells.push_back(std::move(part));
+      }
+      continue;
+    }
+    shells.push_back(std::move(s));
   }
+  if (shells.empty()) return false;
   // Fold the shells into one; shells that do not touch the result are kept as they are by the
   // union as well (a union of disjoint solids is their juxtaposition).
   SurfaceMesh result = shells.front();
@@ -65,19 +112,7 @@ bool union_in_this_process(const TriMesh& closed_shells, TriMesh& out) {
     }
     result = std::move(next);
   }
-  out = TriMesh{};
-  std::vector<int> index(result.number_of_vertices() + result.number_of_removed_vertices(), -1);
-  for (auto v : result.vertices()) {
-    index[v.idx()] = int(out.vertices.size());
-    const Point& p = result.point(v);
-    out.vertices.emplace_back(p.x(), p.y(), p.z());
-  }
-  for (auto f : result.faces()) {
-    Triangle t{};
-    int k = 0;
-    for (auto v : CGAL::vertices_around_face(result.halfedge(f), result)) t[k++] = index[v.idx()];
-    out.triangles.push_back(t);
-  }
+  out.mesh = to_trimesh(result);
   return true;
 }
 
@@ -106,7 +141,7 @@ bool read_all(int fd, void* data, std::size_t bytes) {
 // Corefinement runs in a child process: CGAL checks its preconditions only in debug builds, and
 // some meshes that pass every check we can make still crash it (3DSMaxExport.stl of the shared
 // broken meshes). A crash there must cost the union, not the user's run.
-bool union_of_shells(const TriMesh& closed_shells, TriMesh& out) {
+bool union_of_shells(const TriMesh& closed_shells, UnionResult& out) {
   int fds[2];
   if (::pipe(fds) != 0) return union_in_this_process(closed_shells, out);
   const pid_t child = ::fork();
@@ -116,23 +151,26 @@ bool union_of_shells(const TriMesh& closed_shells, TriMesh& out) {
   }
   if (child == 0) {
     ::close(fds[0]);
-    TriMesh united;
+    UnionResult united;
     const std::uint64_t ok = union_in_this_process(closed_shells, united) ? 1 : 0;
-    const std::uint64_t sizes[3] = {ok, united.vertices.size(), united.triangles.size()};
-    const bool sent = write_all(fds[1], sizes, sizeof sizes) &&
-                      write_all(fds[1], united.vertices.data(), united.vertices.size() * sizeof(Vec3)) &&
-                      write_all(fds[1], united.triangles.data(), united.triangles.size() * sizeof(Triangle));
+    const std::uint64_t sizes[5] = {ok, united.mesh.vertices.size(), united.mesh.triangles.size(),
+                                    united.empty_shells, united.unfolded_shells};
+    const bool sent = write_all(fds[1], sizes, sizeof sizes) && write_all(fds[1], &united.moved_m, sizeof united.moved_m) &&
+                      write_all(fds[1], united.mesh.vertices.data(), united.mesh.vertices.size() * sizeof(Vec3)) &&
+                      write_all(fds[1], united.mesh.triangles.data(), united.mesh.triangles.size() * sizeof(Triangle));
     ::_exit(sent ? 0 : 1);
   }
   ::close(fds[1]);
-  std::uint64_t sizes[3] = {0, 0, 0};
-  TriMesh united;
-  bool received = read_all(fds[0], sizes, sizeof sizes);
+  std::uint64_t sizes[5] = {0, 0, 0, 0, 0};
+  UnionResult united;
+  bool received = read_all(fds[0], sizes, sizeof sizes) && read_all(fds[0], &united.moved_m, sizeof united.moved_m);
   if (received && sizes[0] == 1) {
-    united.vertices.resize(sizes[1]);
-    united.triangles.resize(sizes[2]);
-    received = read_all(fds[0], united.vertices.data(), united.vertices.size() * sizeof(Vec3)) &&
-               read_all(fds[0], united.triangles.data(), united.triangles.size() * sizeof(Triangle));
+    united.mesh.vertices.resize(sizes[1]);
+    united.mesh.triangles.resize(sizes[2]);
+    united.empty_shells = sizes[3];
+    united.unfolded_shells = sizes[4];
+    received = read_all(fds[0], united.mesh.vertices.data(), united.mesh.vertices.size() * sizeof(Vec3)) &&
+               read_all(fds[0], united.mesh.triangles.data(), united.mesh.triangles.size() * sizeof(Triangle));
   }
   ::close(fds[0]);
   int status = 0;

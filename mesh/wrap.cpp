@@ -63,14 +63,24 @@ TriMesh alpha_wrap(const TriMesh& soup, double alpha, double offset) {
   return out;
 }
 
-double max_distance(const TriMesh& from, const TriMesh& to) {
+double max_distance(const TriMesh& from, const TriMesh& to, Samples samples) {
   const std::vector<Triangle3> target = triangles_of(to);
   if (target.empty() || from.triangles.empty()) return 0.0;
   Tree tree(target.begin(), target.end());
   tree.accelerate_distance_queries();
+  // Ray-crossing parity, the majority of three skew rays (one may graze an edge).
+  auto inside_target = [&](const Point& p) {
+    int votes = 0;
+    for (const K::Vector_3 direction : {K::Vector_3(0.5773, 0.5774, 0.5775), K::Vector_3(-0.6123, 0.3211, 0.7222),
+                                        K::Vector_3(0.2345, -0.8765, -0.4203)})
+      votes += tree.number_of_intersected_primitives(K::Ray_3(p, direction)) % 2;
+    return votes >= 2;
+  };
   double worst_squared = 0.0;
-  auto probe = [&](const Vec3& p) {
-    worst_squared = std::max(worst_squared, tree.squared_distance(to_point(p)));
+  auto probe = [&](const Vec3& v) {
+    const Point p = to_point(v);
+    const double d2 = tree.squared_distance(p);
+    if (d2 > worst_squared && !(samples == Samples::outside_target && inside_target(p))) worst_squared = d2;
   };
   // A barycentric grid on every triangle, about 16 points along its longest edge at most.
   const double diagonal = bounding_box(from).size().norm();

@@ -76,12 +76,23 @@ TEST(Repair, LeavesACleanSolidAlone) {
   EXPECT_EQ(r.hausdorff_m, 0.0);
 }
 
-TEST(Repair, OrientsFlippedNormalsOutward) {
-  const mesh::RepairResult r = mesh::repair(test::reversed(test::box_mm(0, 10)), options_mm(), "box.stl");
-  EXPECT_EQ(r.before.orientation, "inward");
+TEST(Repair, OrientsPartlyFlippedFacesOutward) {
+  // Half the faces reversed: the surface has one evident outside, whichever half was wrong.
+  mesh::TriMesh box = test::box_mm(0, 10);
+  for (std::size_t f = 0; f < box.triangles.size(); f += 2) std::swap(box.triangles[f][1], box.triangles[f][2]);
+  const mesh::RepairResult r = mesh::repair(box, options_mm(), "box.stl");
+  EXPECT_EQ(r.before.orientation, "inconsistent");
   EXPECT_EQ(r.after.orientation, "outward");
   EXPECT_NEAR(r.after.volume_m3, 1e-6, 1e-15);
   EXPECT_TRUE(r.repaired);
+}
+
+TEST(Repair, RefusesASurfaceTurnedInsideOut) {
+  // Every face inward: the file bounds the space around the box; which side is meant is a guess.
+  const std::string error = repair_error(test::reversed(test::box_mm(0, 10)));
+  EXPECT_EQ(error.rfind("orientation", 0), 0u) << error;
+  EXPECT_NE(error.find("inside out"), std::string::npos) << error;
+  EXPECT_NE(error.find("Invert Faces"), std::string::npos) << error;
 }
 
 TEST(Repair, MakesDoubleSidedSurfacesSingle) {
