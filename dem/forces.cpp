@@ -7,9 +7,11 @@ namespace dem {
 namespace {
 
 // Rows in parallel: the owner i sums its own share (gravity first, then its pairs in order)
-// straight into f[i]; the partner's share goes to the pair buffer.
+// straight into f[i]; the partner's share goes to the pair buffer. Flattened: the law's slots
+// inline into the loop (GCC otherwise calls the tangential slot, spilling the contact's
+// kinematics to memory for every contact: 12 % slower).
 template <class Law>
-void pair_forces(const Model& model, State& s) {
+[[gnu::flatten]] void pair_forces(const Model& model, State& s) {
   NeighbourList& nl = s.neighbours;
   PairForces& pf = s.pair_forces;
   const std::size_t n = s.size();
@@ -49,12 +51,14 @@ void pair_forces(const Model& model, State& s) {
       nl.touching[std::size_t(p)] = 1;
       ContactHistory& h = nl.history[std::size_t(p)];
       const double dist = std::sqrt(dist2);
-      ContactKinematics c;
-      c.n = d * (1.0 / dist);
-      c.overlap = reach - dist;
       const double rj = s.radius[j], mj = s.mass[j];
-      c.r_eff = ri * rj / reach;
-      c.m_eff = mi * mj / (mi + mj);
+      // One division for three quotients: 1/dist, R* = ri rj / reach and m* = mi mj / (mi + mj).
+      const double inverse = 1.0 / (dist * reach * (mi + mj));
+      ContactKinematics c;
+      c.n = d * (inverse * reach * (mi + mj));
+      c.overlap = reach - dist;
+      c.r_eff = ri * rj * (inverse * dist * (mi + mj));
+      c.m_eff = mi * mj * (inverse * dist * reach);
       const double arm_i = ri - 0.5 * c.overlap, arm_j = rj - 0.5 * c.overlap;
       c.v_rel = vi - wi.cross(arm_i * c.n) - (s.v[j] + s.w[j].cross(arm_j * c.n));
       c.w_rel = wi - s.w[j];
@@ -77,7 +81,7 @@ void pair_forces(const Model& model, State& s) {
 }
 
 template <class Law>
-void wall_forces(const Model& model, State& s) {
+[[gnu::flatten]] void wall_forces(const Model& model, State& s) {
   const std::vector<std::int32_t>& near = s.neighbours.near_wall;
   const double dt = model.dt;
   double max_overlap = s.counters.max_overlap_rel;
