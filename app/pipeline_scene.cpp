@@ -233,7 +233,7 @@ std::string describe(const PipelineScene& s) {
   if (s.spec.skin) out += fmt::format("skin = {}\n", *s.spec.skin);
   out += fmt::format("seed = {}\n", s.seed);
   out += fmt::format("threads = {}                # 0: all cores; results do not depend on it\n", s.threads);
-  out += fmt::format("stop_overlap = {}          # stop (exit status 3) when an overlap exceeds this fraction of a radius: flowing grains overlap 1-2 %, a grain pinched at the rim as the shoe strikes off up to 10 %, a time step past the stable limit far beyond\n\n", s.spec.stop_overlap);
+  out += fmt::format("stop_overlap = {}          # stop (exit status 3) when an overlap exceeds this fraction of a radius: flowing grains overlap 1-2 %, the shoe's cut keeps a grain it pinches under half this, a time step past the stable limit goes far beyond\n\n", s.spec.stop_overlap);
   out += "[density]\n";
   out += fmt::format("voxel = {}                  # [m]; 0: two grain diameters\n", s.density_voxel);
   out += fmt::format("method = \"{}\"             # exact volume split, or \"gaussian\" coarse graining\n\n", s.density_method);

@@ -175,7 +175,8 @@ Model compile_model(const ModelSpec& spec, const State& state, const std::string
   for (const PlaneWall& p : m.planes)
     text += fmt::format(";plane{:a},{:a},{:a},{:a},{:a},{:a},{}", p.point.x(), p.point.y(), p.point.z(), p.normal.x(), p.normal.y(), p.normal.z(), p.material);
   for (const MeshWall& w : m.meshes)
-    text += fmt::format(";mesh{},{},{},{}", w.name, w.field->triangles.size(), w.field->voxel, w.material);
+    text += fmt::format(";mesh{},{},{},{},{:a},{:a}", w.name, w.field->triangles.size(), w.field->voxel, w.material,
+                        w.cut_z, w.cut_fraction);
   m.hash = diefill::sha256_hex(text);
   return m;
 }

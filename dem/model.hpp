@@ -45,12 +45,15 @@ struct MeshWall {
   int material = 0;
   Motion motion;
   std::string name = "mesh";
-  // Grains whose centre lies below this height pass under the wall untouched, and those above
-  // overlap it no deeper than their height above it: a feed shoe cuts the fill at the die
-  // table, and a coarse grain stands for a lump of powder that the cut assigns by its centre.
-  // Without the cut a rigid shoe pinches any grain straddling the cavity's rim against the far
-  // cavity wall, where it can neither rise nor sink.
-  double passes_below_z = -std::numeric_limits<double>::infinity();
+  // The cut: grains whose centre lies less than cut_fraction of their radius above cut_z pass
+  // under the wall untouched, and the others overlap it no deeper than their centre's height
+  // above that level. A feed shoe cuts the fill at the die table, and a coarse grain stands for
+  // a lump of powder that the cut assigns by its centre. Without the cut a rigid shoe pinches
+  // any grain straddling the cavity's rim against the far cavity wall, where it can neither
+  // rise nor sink; with it, a grain pinched between the table and the wall overlaps the two by
+  // at most (1 - cut_fraction) of its radius together.
+  double cut_z = -std::numeric_limits<double>::infinity();
+  double cut_fraction = 0;
 };
 
 // A wall at rest in the world frame.

@@ -15,7 +15,7 @@ int wall_hits(const Model& model, double time, const Vec3& x, double r, WallHit*
   }
   for (std::size_t m = 0; m < model.meshes.size() && count < capacity; ++m) {
     const MeshWall& wall = model.meshes[m];
-    const double height_above_cut = x.z() - wall.passes_below_z;
+    const double height_above_cut = x.z() - (wall.cut_z + wall.cut_fraction * r);
     if (height_above_cut <= 0) continue;
     const bool moving = model.mesh_moves[m];
     const Vec3 local = moving ? wall.motion.to_local(time, x) : x;

@@ -19,6 +19,11 @@ double max_distance(const TriMesh& from, const TriMesh& to, Samples samples = Sa
 // Pairs of intersecting triangles that share no vertex; 0 for a clean mesh.
 std::size_t count_self_intersections(const TriMesh& mesh);
 
+// Re-meshes a closed shell where it folds through itself (CGAL's experimental self-intersection
+// removal: local smoothing and hole filling). False when folds remain or the shell opens; then
+// `shell` is unspecified. Its own translation unit: the header doubles union.cpp's build time.
+bool remove_folds(TriMesh& shell);
+
 }  // namespace mesh::detail
 
 namespace mesh::detail {

@@ -6,7 +6,6 @@
 #include <CGAL/Polygon_mesh_processing/orientation.h>
 #include <CGAL/Polygon_mesh_processing/measure.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
-#include <CGAL/Polygon_mesh_processing/repair_self_intersections.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
 
@@ -43,18 +42,23 @@ TriMesh to_trimesh(const SurfaceMesh& sm) {
   return out;
 }
 
-bool union_in_this_process(const TriMesh& closed_shells, UnionResult& out) {
+// False when the triangles do not form a polygon mesh (an edge shared the wrong way).
+bool to_surface_mesh(const TriMesh& mesh, SurfaceMesh& out) {
   std::vector<Point> points;
-  for (const Vec3& v : closed_shells.vertices) points.emplace_back(v.x(), v.y(), v.z());
+  for (const Vec3& v : mesh.vertices) points.emplace_back(v.x(), v.y(), v.z());
   std::vector<std::array<std::size_t, 3>> faces;
-  for (const Triangle& t : closed_shells.triangles)
-    faces.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
+  for (const Triangle& t : mesh.triangles) faces.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
+  if (!PMP::is_polygon_soup_a_polygon_mesh(faces)) return false;
+  PMP::polygon_soup_to_polygon_mesh(points, faces, out);
+  return true;
+}
+
+bool union_in_this_process(const TriMesh& closed_shells, UnionResult& out) {
   SurfaceMesh all;
-  if (!PMP::is_polygon_soup_a_polygon_mesh(faces)) {
+  if (!to_surface_mesh(closed_shells, all)) {
     diefill::log::debug("union: the surface is not a polygon mesh");
     return false;
   }
-  PMP::polygon_soup_to_polygon_mesh(points, faces, all);
   const double scale = mesh::bounding_box(closed_shells).size().maxCoeff();
   std::vector<SurfaceMesh> split, shells;
   PMP::split_connected_components(all, split);
@@ -78,20 +82,21 @@ bool union_in_this_process(const TriMesh& closed_shells, UnionResult& out) {
       continue;
     }
     if (!PMP::is_outward_oriented(s)) PMP::reverse_face_orientations(s);
-    // A shell folded through itself (a decimated scan): CGAL re-meshes the folds locally. That
-    // moves surface, measured here against the shell as it was.
+    // A shell folded through itself (a decimated scan) is re-meshed where it folds: that moves
+    // surface, measured against the shell as it was, on the faces left outside the result.
     if (PMP::does_self_intersect(s)) {
       const TriMesh folded = to_trimesh(s);
-      if (!PMP::experimental::remove_self_intersections(s, CGAL::parameters::preserve_genus(false)) ||
-          PMP::does_self_intersect(s) || !CGAL::is_closed(s)) {
+      TriMesh unfolded = folded;
+      SurfaceMesh fixed;
+      if (!remove_folds(unfolded) || !to_surface_mesh(unfolded, fixed)) {
         diefill::log::debug("union: the folds of a shell of {} faces could not be removed", s.number_of_faces());
         return false;
       }
-      out.moved_m = std::max(out.moved_m, max_distance(folded, to_trimesh(s), Samples::outside_target));
+      out.moved_m = std::max(out.moved_m, max_distance(folded, unfolded, Samples::outside_target));
       ++out.unfolded_shells;
       // Re-meshing may part a fold into separate shells (an inner lobe): each joins the union.
       std::vector<SurfaceMesh> parts;
-      PMP::split_connected_components(s, parts);
+      PMP::split_connected_components(fixed, parts);
       for (SurfaceMesh& part : parts) {
         if (!PMP::is_outward_oriented(part)) PMP::reverse_face_orientations(part);
         shells.push_back(std::move(part));
