@@ -7,7 +7,9 @@ namespace dem {
 namespace {
 
 // Rows in parallel: the owner i sums its own share (gravity first, then its pairs in order)
-// straight into f[i]; the partner's share goes to the pair buffer. Flattened: the law's slots
+// straight into f[i]; the partner's share goes to the pair buffer. Every pass over the grains
+// splits them statically, alike: each thread meets the same grains in every stage, which stay
+// in its core's cache (dynamic chunks moved them between cores: 17 % slower on two threads). Flattened: the law's slots
 // inline into the loop (GCC otherwise calls the tangential slot, spilling the contact's
 // kinematics to memory for every contact: 12 % slower).
 template <class Law>
@@ -18,7 +20,7 @@ template <class Law>
   const double dt = model.dt;
   double max_overlap = 0;
   std::int64_t contacts = 0;
-#pragma omp parallel for schedule(dynamic, 512) reduction(max : max_overlap) reduction(+ : contacts)
+#pragma omp parallel for schedule(static) reduction(max : max_overlap) reduction(+ : contacts)
   for (std::size_t i = 0; i < n; ++i) {
     const std::int32_t first = nl.row_start[i], last = nl.row_start[i + 1];
     if (!s.active[i]) {
@@ -90,7 +92,7 @@ template <class Law>
   power.assign(near.size(), 0.0);
   const std::size_t walls = model.meshes.size();
   if (s.wall_candidates.size() != near.size() * walls) s.wall_candidates.assign(near.size() * walls, WallCandidates{});
-#pragma omp parallel for schedule(dynamic, 256) reduction(max : max_overlap) reduction(+ : contacts)
+#pragma omp parallel for schedule(static) reduction(max : max_overlap) reduction(+ : contacts)
   for (std::size_t q = 0; q < near.size(); ++q) {
     const std::size_t i = std::size_t(near[q]);
     if (!s.active[i]) continue;
@@ -183,7 +185,7 @@ struct WallStage {
 void compute_pair_forces(const Model& model, State& state) { dispatch<PairStage>(model, state); }
 void compute_wall_forces(const Model& model, State& state) { dispatch<WallStage>(model, state); }
 
-void sum_forces(const Model&, State& s) {
+void sum_forces(State& s, double kick_dt) {
   const NeighbourList& nl = s.neighbours;
   const PairForces& pf = s.pair_forces;
   const std::size_t n = s.size();
@@ -198,6 +200,11 @@ void sum_forces(const Model&, State& s) {
     }
     s.f[j] = f;
     s.torque[j] = t;
+    // Clump members move with their bodies, kicked once their members' forces are summed.
+    if (kick_dt > 0 && s.body[j] < 0) {
+      s.v[j] += (kick_dt / s.mass[j]) * f;
+      s.w[j] += (kick_dt / s.inertia[j]) * t;
+    }
   }
 }
 

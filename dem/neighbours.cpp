@@ -100,19 +100,14 @@ struct OldPair {
 
 }  // namespace
 
-bool needs_rebuild(const Model& model, const State& s) {
+bool needs_rebuild(const Model& model, const State& s, double largest_shift2) {
   const NeighbourList& nl = s.neighbours;
   if (nl.x_at_build.size() != s.size()) return true;
-  double worst = 0;
-  const std::size_t n = s.size();
-#pragma omp parallel for reduction(max : worst) schedule(static)
-  for (std::size_t i = 0; i < n; ++i)
-    if (s.active[i]) worst = std::max(worst, (s.x[i] - nl.x_at_build[i]).squaredNorm());
   double wall_shift = 0;
   for (std::size_t m = 0; m < model.meshes.size(); ++m)
     wall_shift = std::max(wall_shift, (model.meshes[m].motion.position(s.time) - nl.wall_shift_at_build[m]).norm());
   // A rotating wall moves its points by up to |ω| r; the shoe does not rotate, others are fixed.
-  return std::sqrt(worst) + wall_shift > 0.5 * model.skin;
+  return std::sqrt(largest_shift2) + wall_shift > 0.5 * model.skin;
 }
 
 void rebuild_neighbours(const Model& model, State& s) {

@@ -8,7 +8,8 @@
 
 namespace dem {
 
-bool needs_rebuild(const Model& model, const State& state);
+// `largest_shift2`: the largest squared displacement of a grain since the last build [m²].
+bool needs_rebuild(const Model& model, const State& state, double largest_shift2);
 // Marks particles outside the domain as lost, re-sorts, rebuilds the list, carries history.
 void rebuild_neighbours(const Model& model, State& state);
 

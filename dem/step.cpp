@@ -15,35 +15,41 @@ namespace dem {
 
 namespace {
 
-// Clump members move with their bodies, which move last.
-void kick(State& s, double half_dt) {
-  const std::size_t n = s.size();
-#pragma omp parallel for schedule(static)
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!s.active[i] || s.body[i] >= 0) continue;
-    s.v[i] += (half_dt / s.mass[i]) * s.f[i];
-    s.w[i] += (half_dt / s.inertia[i]) * s.torque[i];
-  }
+// The first half of velocity Verlet in one pass: free grains kicked by half a step and moved a
+// step (clump members were placed by their bodies already), and the largest displacement of any
+// grain since the neighbour list was built, which decides whether to rebuild it.
+double kick_and_drift(State& s, double half_dt, double dt) {
   kick_bodies(s, half_dt);
-}
-
-void drift(State& s, double dt) {
-  const std::size_t n = s.size();
-#pragma omp parallel for schedule(static)
-  for (std::size_t i = 0; i < n; ++i)
-    if (s.active[i] && s.body[i] < 0) s.x[i] += dt * s.v[i];
   drift_bodies(s, dt);
+  const std::size_t n = s.size();
+  const std::vector<Vec3>& built = s.neighbours.x_at_build;
+  const bool listed = built.size() == n;
+  double largest = 0;
+#pragma omp parallel for schedule(static) reduction(max : largest)
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!s.active[i]) continue;
+    if (s.body[i] < 0) {
+      s.v[i] += (half_dt / s.mass[i]) * s.f[i];
+      s.w[i] += (half_dt / s.inertia[i]) * s.torque[i];
+      s.x[i] += dt * s.v[i];
+    }
+    if (listed) largest = std::max(largest, (s.x[i] - built[i]).squaredNorm());
+  }
+  return largest;
 }
 
-void forces(const Model& model, State& s, StageTimes* times) {
+// Forces on every grain; with kick_dt > 0 the second half kick of velocity Verlet follows in
+// the same passes. Walls come before the partners' shares so that the last pass over the grains
+// completes each force and kicks with it.
+void forces(const Model& model, State& s, StageTimes* times, double kick_dt) {
   diefill::Stopwatch clock;
   compute_pair_forces(model, s);
   if (times) times->pair_forces += clock.seconds(), clock.restart();
-  sum_forces(model, s);
-  if (times) times->sums += clock.seconds(), clock.restart();
   compute_wall_forces(model, s);
   if (times) times->wall_forces += clock.seconds(), clock.restart();
+  sum_forces(s, kick_dt);
   sum_body_forces(model, s);
+  if (kick_dt > 0) kick_bodies(s, kick_dt);
   if (times) times->sums += clock.seconds();
 }
 
@@ -146,7 +152,7 @@ void initialize(const Model& model, State& s) {
   s.torque.resize(s.size(), Vec3::Zero());
   s.wall_slots.resize(s.size() * wall_slots_per_particle);
   rebuild_neighbours(model, s);
-  forces(model, s, nullptr);
+  forces(model, s, nullptr, 0);
   s.energy_reference = kinetic_energy(s) + potential_energy(model, s) + elastic_energy(model, s);
   s.energy_scale = 0;
   for (std::size_t i = 0; i < s.size(); ++i)
@@ -160,17 +166,14 @@ void initialize(const Model& model, State& s) {
 
 StepReport step(const Model& model, State& s, StageTimes* times) {
   diefill::Stopwatch clock;
-  kick(s, 0.5 * model.dt);
-  drift(s, model.dt);
+  const double largest_shift2 = kick_and_drift(s, 0.5 * model.dt, model.dt);
   s.time += model.dt;
   ++s.step;
   if (times) times->integration += clock.seconds(), clock.restart();
-  if (needs_rebuild(model, s)) rebuild_neighbours(model, s);
+  if (needs_rebuild(model, s, largest_shift2)) rebuild_neighbours(model, s);
   if (times) times->neighbours += clock.seconds(), clock.restart();
-  forces(model, s, times);
+  forces(model, s, times, 0.5 * model.dt);
   clock.restart();
-  kick(s, 0.5 * model.dt);
-  if (times) times->integration += clock.seconds(), clock.restart();
   StepReport report = monitor(model, s);
   if (times) times->monitor += clock.seconds();
   return report;

@@ -1,7 +1,8 @@
 #pragma once
 // One time step, as a table of contents of its stages (each timed):
-//   kick (half) -> drift -> neighbour update (when needed) -> grain-grain forces -> sums ->
-//   grain-wall forces -> body sums (clumps) -> kick (half) -> monitor
+//   kick (half) and drift -> neighbour update (when needed) -> grain-grain forces ->
+//   grain-wall forces -> sums with the second half kick -> body sums and kick (clumps) -> monitor
+// ("sums" times the last pass over the grains, kick included).
 // Velocity Verlet: second order and symplectic for conservative forces; clumps rotate by the
 // splitting in bodies.hpp.
 #include <string>
