@@ -5,6 +5,9 @@
 // directional torque) and cohesion (simplified JKR). Each slot is a small struct with its
 // parameters and a pure function; the force loop is instantiated once per combination in use
 // (forces.cpp), so adding a law never touches the loop. Equations: ../shared/docs/PHYSICS.md §2.
+// The laws choose by selection, not by branches: the pair loop evaluates them over batches of
+// contacts that the compiler vectorises (one contact per lane, the same IEEE operations as one
+// at a time), which a branch would forbid.
 #include <cmath>
 #include <cstdint>
 
@@ -86,11 +89,12 @@ struct MindlinTangential {
     Vec3 force = -kt * spring - (p.sqrt_kt_over_kn * normal_gamma) * vt;
     const double cap = p.mu_s * normal_force;
     const double magnitude2 = force.squaredNorm();
-    if (magnitude2 > cap * cap) {
-      // Gross sliding: the force sits on the Coulomb cap and the spring is reset to it.
-      force *= cap / std::sqrt(magnitude2);
-      spring = kt > 0 ? Vec3(-force / kt) : Vec3(Vec3::Zero());
-    }
+    // Gross sliding: the force sits on the Coulomb cap and the spring is reset to it.
+    const bool sliding = magnitude2 > cap * cap;
+    force *= sliding ? cap / std::sqrt(magnitude2) : 1.0;
+    const double kt_or_one = kt > 0 ? kt : 1.0;
+    for (int k = 0; k < 3; ++k)
+      spring[k] = sliding ? (kt > 0 ? -force[k] / kt_or_one : 0.0) : spring[k];
     return force;
   }
 };
@@ -114,7 +118,7 @@ struct EpsdRolling {
     torque -= kr * w_roll * dt;
     const double cap = p.mu_r * c.r_eff * normal_force;
     const double magnitude2 = torque.squaredNorm();
-    if (magnitude2 > cap * cap) torque *= cap / std::sqrt(magnitude2);
+    torque *= magnitude2 > cap * cap ? cap / std::sqrt(magnitude2) : 1.0;
     return torque;
   }
 };
@@ -125,8 +129,8 @@ struct CdtRolling {
                    double, Vec3&) {
     const Vec3 w_roll = c.w_rel - c.n * c.n.dot(c.w_rel);
     const double w = w_roll.norm();
-    if (w < 1e-12) return Vec3::Zero();
-    return -(p.mu_r * c.r_eff * normal_force / w) * w_roll;
+    const double w_or_one = w < 1e-12 ? 1.0 : w;
+    return -(w < 1e-12 ? 0.0 : p.mu_r * c.r_eff * normal_force / w_or_one) * w_roll;
   }
 };
 struct NoRolling {
