@@ -30,14 +30,18 @@ struct ContactBatch {
   double overlap_rel[capacity];
 };
 
-// The law over a batch; each lane is one contact, computed exactly as alone.
+// The law over a batch; each lane is one contact, computed exactly as alone. With one material
+// for every grain (`common` given) the pairs' parameters are that pair's, not gathered.
 template <class Law>
-[[gnu::flatten]] void evaluate(ContactBatch& b, double dt) {
+[[gnu::flatten]] void evaluate(ContactBatch& b, double dt, const PairParams* common) {
+  const PairParams shared = common ? *common : PairParams{};
   for (int k = 0; k < b.size; ++k) {
-    PairParams p;
-    p.e_star = b.e_star[k], p.damping = b.damping[k], p.mu_s = b.mu_s[k], p.mu_r = b.mu_r[k];
-    p.k_linear = b.k_linear[k], p.kt_over_kn = b.kt_over_kn[k], p.sqrt_kt_over_kn = b.sqrt_kt_over_kn[k];
-    p.cohesion = b.cohesion[k];
+    PairParams p = shared;
+    if (!common) {
+      p.e_star = b.e_star[k], p.damping = b.damping[k], p.mu_s = b.mu_s[k], p.mu_r = b.mu_r[k];
+      p.k_linear = b.k_linear[k], p.kt_over_kn = b.kt_over_kn[k], p.sqrt_kt_over_kn = b.sqrt_kt_over_kn[k];
+      p.cohesion = b.cohesion[k];
+    }
     const Vec3 d(b.dx[k], b.dy[k], b.dz[k]);
     const double ri = b.ri[k], rj = b.rj[k], mi = b.mi[k], mj = b.mj[k];
     const double reach = ri + rj;
@@ -92,12 +96,14 @@ void pair_forces(const Model& model, State& s) {
   const double dt = model.dt;
   double max_overlap = 0;
   std::int64_t contacts = 0;
+  const PairParams* common = model.materials.size() == 1 ? &model.params(0, 0) : nullptr;
 #pragma omp parallel reduction(max : max_overlap) reduction(+ : contacts)
   {
-    static thread_local ContactBatch b;
+    static thread_local ContactBatch batch;
+    ContactBatch& b = batch;
     b.size = 0;
     auto flush = [&] {
-      evaluate<Law>(b, dt);
+      evaluate<Law>(b, dt, common);
       for (int k = 0; k < b.size; ++k) {
         const std::size_t i = std::size_t(b.row[k]), p = std::size_t(b.pair[k]);
         const Vec3 force(b.fx[k], b.fy[k], b.fz[k]);
@@ -145,7 +151,6 @@ void pair_forces(const Model& model, State& s) {
         if (b.size == ContactBatch::capacity) flush();
         const int k = b.size++;
         const ContactHistory& h = nl.history[std::size_t(p)];
-        const PairParams& pp = model.params(mat_i, s.material[j]);
         const Vec3 vj = s.v[j], wj = s.w[j];
         b.pair[k] = std::int32_t(p), b.row[k] = std::int32_t(i);
         b.dx[k] = d.x(), b.dy[k] = d.y(), b.dz[k] = d.z();
@@ -154,9 +159,12 @@ void pair_forces(const Model& model, State& s) {
         b.vjx[k] = vj.x(), b.vjy[k] = vj.y(), b.vjz[k] = vj.z(), b.wjx[k] = wj.x(), b.wjy[k] = wj.y(), b.wjz[k] = wj.z();
         b.tx[k] = h.tangential.x(), b.ty[k] = h.tangential.y(), b.tz[k] = h.tangential.z();
         b.rx[k] = h.rolling.x(), b.ry[k] = h.rolling.y(), b.rz[k] = h.rolling.z();
-        b.e_star[k] = pp.e_star, b.damping[k] = pp.damping, b.mu_s[k] = pp.mu_s, b.mu_r[k] = pp.mu_r;
-        b.k_linear[k] = pp.k_linear, b.kt_over_kn[k] = pp.kt_over_kn, b.sqrt_kt_over_kn[k] = pp.sqrt_kt_over_kn;
-        b.cohesion[k] = pp.cohesion;
+        if (!common) {
+          const PairParams& pp = model.params(mat_i, s.material[j]);
+          b.e_star[k] = pp.e_star, b.damping[k] = pp.damping, b.mu_s[k] = pp.mu_s, b.mu_r[k] = pp.mu_r;
+          b.k_linear[k] = pp.k_linear, b.kt_over_kn[k] = pp.kt_over_kn, b.sqrt_kt_over_kn[k] = pp.sqrt_kt_over_kn;
+          b.cohesion[k] = pp.cohesion;
+        }
       }
     }
     flush();

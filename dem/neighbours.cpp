@@ -180,7 +180,15 @@ void rebuild_neighbours(const Model& model, State& s) {
             if ((s.x[std::size_t(j)] - xi).squaredNorm() < reach * reach) row.push_back(j);
           }
         }
+    // Pairs touching now first, then the others, each part ascending: the force loop tests every
+    // listed pair for contact, and contacts last thousands of steps, so the outcome runs in two
+    // predictable stretches per row instead of at random (a mispredicted branch per pair cost
+    // about a tenth of the force loop).
     std::sort(row.begin(), row.end());
+    std::stable_partition(row.begin(), row.end(), [&](std::int32_t j) {
+      const double reach = s.radius[i] + s.radius[std::size_t(j)];
+      return (s.x[std::size_t(j)] - xi).squaredNorm() < reach * reach;
+    });
   }
 
   nl.row_start.assign(n + 1, 0);
@@ -189,18 +197,23 @@ void rebuild_neighbours(const Model& model, State& s) {
   nl.partner.resize(pairs);
   nl.history.assign(pairs, ContactHistory{});
   nl.touching.assign(pairs, 0);
-  std::size_t cursor = 0;  // into `old`, which is sorted like the new list
+  std::size_t cursor = 0;  // into `old`, sorted by row and partner: row i's old pairs are [cursor, row_end)
   for (std::size_t i = 0; i < n; ++i) {
+    while (cursor < old.size() && old[cursor].i < std::int32_t(i)) ++cursor;
+    std::size_t row_end = cursor;
+    while (row_end < old.size() && old[row_end].i == std::int32_t(i)) ++row_end;
     std::size_t p = std::size_t(nl.row_start[i]);
     for (std::int32_t j : rows[i]) {
       nl.partner[p] = j;
-      while (cursor < old.size() && (old[cursor].i < std::int32_t(i) || (old[cursor].i == std::int32_t(i) && old[cursor].j < j))) ++cursor;
-      if (cursor < old.size() && old[cursor].i == std::int32_t(i) && old[cursor].j == j) {
-        nl.history[p] = old[cursor].history;
+      const auto found = std::lower_bound(old.begin() + std::ptrdiff_t(cursor), old.begin() + std::ptrdiff_t(row_end), j,
+                                          [](const OldPair& o, std::int32_t partner) { return o.j < partner; });
+      if (found != old.begin() + std::ptrdiff_t(row_end) && found->j == j) {
+        nl.history[p] = found->history;
         nl.touching[p] = 1;
       }
       ++p;
     }
+    cursor = row_end;
   }
   // Reverse index: for each j, the pairs naming it, ascending.
   nl.reverse_start.assign(n + 1, 0);
