@@ -10,14 +10,15 @@
 #include "dem/step.hpp"
 #include "mesh/sdf.hpp"
 #include "mesh/shapes.hpp"
+#include "mesh/tool.hpp"
 
 namespace app::study {
 
 using dem::Vec3;
 
-namespace {
-
 double grain_volume(double diameter) { return std::numbers::pi / 6 * diameter * diameter * diameter; }
+
+namespace {
 
 dem::PlaneWall plane(const Vec3& point, const Vec3& normal, int material, const std::string& name) {
   return {point, normal, material, name};
@@ -147,14 +148,20 @@ LineFit steady_rate(const SlotRun& run) {
 HeapRun run_heap(const Powder& p, const Heap& h, const std::string& label) {
   const double r = p.r_max(), d = p.diameter, base = 4 * d;
   dem::ModelSpec spec = p.spec;
-  // The pedestal is rough, as if coated with the powder (heaps are measured on a glued layer of
-  // grains): powder against powder, or grains would roll off a polished base.
+  // Heaps are measured on a base with a layer of grains fixed to it. On a flat plate, however
+  // frictional, the bottom layer rolls outward like ball bearings (rolling friction holds a
+  // slope of only atan mu_r) and the heap spreads to a few grains' thickness; here the
+  // pedestal's top is a dish one grain deep whose first grains, held by its rim, become that
+  // layer. The pedestal is powder against powder.
   dem::Material base_material = spec.materials[std::size_t(p.powder)];
   base_material.name = "heap base";
   spec.materials.push_back(base_material);
   const int rough = int(spec.materials.size()) - 1;
-  const mesh::TriMesh pedestal = mesh::ring_cavity(2 * h.pedestal_radius, 0, base, 0.01 * d);
-  spec.meshes = {dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(mesh::contact_wall_field(pedestal, r)), rough, "pedestal")};
+  const mesh::TriMesh dish = mesh::ring_cavity(2 * h.pedestal_radius, 0, d, 0.01 * d);
+  mesh::TableExtent table = mesh::table_around(dish, 0.25 * d);
+  table.thickness = base;
+  const mesh::ToolMesh pedestal = mesh::tool_from_cavity(dish, table, "heap pedestal");
+  spec.meshes = {dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(mesh::contact_wall_field(pedestal.mesh, r)), rough, "pedestal")};
 
   // Batches every 10 ms: a stream of the asked rate, each batch dropped just above the heap.
   const double batch_period = 0.01;
@@ -189,7 +196,7 @@ HeapRun run_heap(const Powder& p, const Heap& h, const std::string& label) {
     advance(*model, run.state, run.state.time + batch_period, fmt::format("{}: pouring ({} of {})", label, poured, h.grains));
   }
   advance(*model, run.state, run.state.time + h.settle_time, label + ": settling");
-  for (std::size_t i = 0; i < run.state.size(); ++i) run.on_pedestal += run.state.active[i] && run.state.x[i].z() > 0;
+  for (std::size_t i = 0; i < run.state.size(); ++i) run.on_pedestal += run.state.active[i] && run.state.x[i].z() > -d;  // the dish's grains too
   return run;
 }
 
@@ -213,9 +220,9 @@ OutflowAngle outflow_angle(const dem::State& s, const SlotContainer& c, double d
 
 SurfaceFit fit_heap_surface(const dem::State& s, const Heap& h, double d) {
   // Rings one grain wide, each the mean of the highest tops in eight sectors (the maximum over a
-  // whole ring would rise with its area); the apex and the toe left out.
+  // whole ring would rise with its area); the toe and the apex, flattened under the stream, left out.
   constexpr int sectors = 8;
-  const double from = 0.2 * h.pedestal_radius, to = 0.85 * h.pedestal_radius;
+  const double from = std::max(0.2 * h.pedestal_radius, h.stream_radius + d), to = 0.85 * h.pedestal_radius;
   const auto rings = std::size_t(std::max(0.0, std::floor((to - from) / d)));
   const std::vector<double> top = column_tops(s, rings * sectors, [&](const Vec3& x) {
     const double radius = std::hypot(x.x(), x.y());

@@ -13,6 +13,8 @@
 
 namespace app::study {
 
+double grain_volume(double diameter);  // [m³] of a sphere
+
 struct SlotContainer {
   double length = 0, width = 0, fill_height = 0;  // inner [m]; the slot runs along y, across the width
   double slot_width = 0;                          // [m], centred at x = 0

@@ -61,6 +61,31 @@ TEST(Study, DischargeFollowsTheBeverlooSlotLawAndTheCriticalVelocityLaw) {
   EXPECT_LT(critical["v_c_m_s"].get<double>(), shoe["speeds_m_s"][1].get<double>());
 }
 
+// Repose (1.6 mm grains; the scene's powder, μ = 0.5 and μ_r = 0.1, then less sliding and no
+// rolling friction): both angles rise with either friction by more than two combined standard
+// errors. Zhou et al.'s correlation is a trend from another bench (PHYSICS.md §3), so the
+// scene's angles need only lie within 5° of it, plus two standard errors.
+TEST(Study, ReposeAnglesRiseWithFrictionNearTheZhouCorrelation) {
+  const nlohmann::json r = run_reduced("repose");
+  const auto run_with = [&](double sliding, double rolling) {
+    for (const auto& x : r["runs"])
+      if (x["sliding_friction"].get<double>() == sliding && x["rolling_friction"].get<double>() == rolling) return x;
+    ADD_FAILURE() << "no run with μ = " << sliding << ", μ_r = " << rolling;
+    return nlohmann::json();
+  };
+  const nlohmann::json scene = run_with(0.5, 0.1), less_sliding = run_with(0.25, 0.1), no_rolling = run_with(0.5, 0.0);
+  for (const char* angle : {"heap", "outflow"}) {
+    const std::string value = std::string(angle) + "_angle_deg", error = std::string(angle) + "_angle_error_deg";
+    for (const nlohmann::json* lower : {&less_sliding, &no_rolling}) {
+      EXPECT_GT(scene[value].get<double>() - (*lower)[value].get<double>(),
+                2 * std::hypot(scene[error].get<double>(), (*lower)[error].get<double>()))
+          << angle << ": " << scene.dump() << " against " << lower->dump();
+    }
+    EXPECT_NEAR(scene[value].get<double>(), scene["zhou_angle_deg"].get<double>(), 5 + 2 * scene[error].get<double>())
+        << angle << ": " << scene.dump();
+  }
+}
+
 // Coarse graining (PHYSICS.md §4) at grains of 0.8, 1.13 and 1.6 mm in one slot container (the
 // coarsest five grains across its slot and its length) and the ring die.
 TEST(Study, CoarseGrainingKeepsFlowAndReposeOnceTheBoundaryIsCorrected) {
