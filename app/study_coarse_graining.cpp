@@ -56,12 +56,12 @@ double ring_core_solid_fraction(const dem::State& s, double margin, double voxel
 }
 
 // The fixed geometry, in units of the coarsest grain D.
-struct Sizes {
+struct CoarseGrainingSizes {
   std::vector<double> relative_sizes;  // of the grains, against the scene's
   double slot, beside_slot, width, fill_height;
 };
 
-Sizes sizes(bool reduced) {
+CoarseGrainingSizes coarse_graining_sizes(bool reduced) {
   if (reduced) return {{1, std::sqrt(2.0), 2}, 5, 10, 5, 8};
   return {{0.5, 1, 2}, 6, 10, 5, 8};
 }
@@ -113,7 +113,7 @@ double beverloo_k_across(const std::vector<double>& rates, const std::vector<dou
 }  // namespace
 
 void coarse_graining(const PipelineScene& scene_in, bool reduced, Output& out) {
-  const Sizes z = sizes(reduced);
+  const CoarseGrainingSizes z = coarse_graining_sizes(reduced);
   const PipelineScene scene = affordable(scene_in);
   const double coarsest = scene.grain_diameter() * z.relative_sizes.back();
   SlotContainer box;

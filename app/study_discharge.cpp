@@ -22,14 +22,14 @@ namespace {
 
 using dem::Vec3;
 
-struct Sizes {
+struct DischargeSizes {
   std::vector<double> slot_widths;  // [grain diameters]
   double container_width, fill_height, flow_time;
   std::vector<double> speeds;       // [m/s]
   double opening, bin_depth, shoe_fill;  // [grain diameters]
 };
 
-Sizes sizes(bool reduced) {
+DischargeSizes discharge_sizes(bool reduced) {
   if (reduced) return {{5, 7, 9}, 8, 14, 0.2, {0.15, 0.35, 0.6, 0.9}, 10, 20, 12};
   return {{5, 6.5, 8, 10, 12}, 10, 20, 0.3, {0.1, 0.2, 0.35, 0.55, 0.8}, 10, 20, 12};
 }
@@ -100,7 +100,7 @@ std::vector<double> sweep(double lo, double hi, int n) {
 
 void discharge(const PipelineScene& scene, bool reduced, Output& out) {
   const Powder powder = powder_of(scene);
-  const Sizes z = sizes(reduced);
+  const DischargeSizes z = discharge_sizes(reduced);
   const double d = powder.diameter, g = powder.spec.gravity.norm();
 
   // (a) Slot flow.
