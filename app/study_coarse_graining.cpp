@@ -127,6 +127,10 @@ void coarse_graining(const PipelineScene& scene_in, bool reduced, Output& out) {
   const double ring_area = std::numbers::pi * (ring_outer_radius * ring_outer_radius - ring_inner_radius * ring_inner_radius);
   const double ring_volume = ring_area * ring_depth;
   const double ring_surface = 2 * ring_area + 2 * std::numbers::pi * (ring_outer_radius + ring_inner_radius) * ring_depth;
+  // Reduced, the ring is not filled: 0.8-1.6 mm grains are 3 to 6 across its annulus, far from
+  // the 20 that PHYSICS.md §4 asks for, so their fill tests no invariance (the pipeline tests
+  // fill it); the slot container scales with the grains and is the whole reduced study.
+  const bool fill_ring = !reduced;
 
   std::vector<FactorResult> results;
   for (double relative : z.relative_sizes) {
@@ -149,21 +153,25 @@ void coarse_graining(const PipelineScene& scene_in, bool reduced, Output& out) {
     // The same columns for every factor: clear of the slot and the end wall by the coarsest grain.
     f.outflow = outflow_angle(slot.state, box, f.diameter, coarsest);
 
-    s.out = out.work() / fmt::format("ring_alpha_{:.3g}", f.alpha);
-    s.fill_height = 5e-3;  // twice what the ring takes
-    s.side_margin = 2e-3;
-    const DieRun ring = run_die_fill(s, ring_mesh(out.work()), false);
-    const dem::State fill = dem::read_particles(ring.dir / "particles.csv", 0, powder.density);
-    f.fill_ratio = ring.report["fill"].value("fill_ratio", 0.0);
-    f.cavity_grains = ring.report["particles"].value("in_cavity", std::size_t(0));
-    f.core_fraction = ring_core_solid_fraction(fill, coarsest, 0.25 * scene.grain_diameter() * z.relative_sizes.front());
-    // A layer of thickness t empty and the rest at the core's fraction gives the mean fill.
-    f.wall_layer = ring_volume / ring_surface * (1 - f.fill_ratio / f.core_fraction);
+    if (fill_ring) {
+      s.out = out.work() / fmt::format("ring_alpha_{:.3g}", f.alpha);
+      s.fill_height = 5e-3;  // twice what the ring takes
+      s.side_margin = 2e-3;
+      const DieRun ring = run_die_fill(s, ring_mesh(out.work()), false);
+      const dem::State fill = dem::read_particles(ring.dir / "particles.csv", 0, powder.density);
+      f.fill_ratio = ring.report["fill"].value("fill_ratio", 0.0);
+      f.cavity_grains = ring.report["particles"].value("in_cavity", std::size_t(0));
+      f.core_fraction = ring_core_solid_fraction(fill, coarsest, 0.25 * scene.grain_diameter() * z.relative_sizes.front());
+      // A layer of thickness t empty and the rest at the core's fraction gives the mean fill.
+      f.wall_layer = ring_volume / ring_surface * (1 - f.fill_ratio / f.core_fraction);
+    }
     f.seconds = clock.seconds();
-    diefill::log::info("{}: flow {:.2f} g/s (real-powder Beverloo {:.2f}), outflow {:.1f}° ± {:.1f}°, ring fill {:.3f}, core {:.3f}, "
-                       "wall layer {:.2f} d; {:.0f} s",
-                       label, f.rate * 1e3, f.corrected_rate * 1e3, f.outflow.angle_deg, f.outflow.error_deg, f.fill_ratio,
-                       f.core_fraction, f.wall_layer / f.diameter, f.seconds);
+    diefill::log::info("{}: flow {:.2f} g/s (real-powder Beverloo {:.2f}), outflow {:.1f}° ± {:.1f}°{}; {:.0f} s", label, f.rate * 1e3,
+                       f.corrected_rate * 1e3, f.outflow.angle_deg, f.outflow.error_deg,
+                       fill_ring ? fmt::format(", ring fill {:.3f}, core {:.3f}, wall layer {:.2f} d", f.fill_ratio, f.core_fraction,
+                                               f.wall_layer / f.diameter)
+                                 : "",
+                       f.seconds);
     results.push_back(f);
   }
 
@@ -186,9 +194,11 @@ void coarse_graining(const PipelineScene& scene_in, bool reduced, Output& out) {
   const double real_fill = core * (1 - ring_surface * layer * scene.particle_diameter / ring_volume);
 
   std::vector<std::vector<nlohmann::json>> rows;
+  const auto ring_cell = [&](nlohmann::json value) { return fill_ring ? value : nlohmann::json(""); };
   for (const FactorResult& f : results)
     rows.push_back({f.alpha, f.diameter, f.slot_grains, f.rate, f.rate_error, f.corrected_rate, f.bulk_density, f.outflow.angle_deg,
-                    f.outflow.error_deg, f.cavity_grains, f.fill_ratio, f.core_fraction, f.wall_layer, f.seconds});
+                    f.outflow.error_deg, ring_cell(f.cavity_grains), ring_cell(f.fill_ratio), ring_cell(f.core_fraction),
+                    ring_cell(f.wall_layer), f.seconds});
   out.table("coarse_graining.csv",
             {"alpha", "grain_diameter_m", "slot_grains", "rate_kg_s", "rate_error_kg_s", "beverloo_corrected_rate_kg_s",
              "bulk_density_kg_m3", "outflow_angle_deg", "outflow_error_deg", "ring_grains_in_cavity", "ring_fill_ratio",
@@ -204,8 +214,10 @@ void coarse_graining(const PipelineScene& scene_in, bool reduced, Output& out) {
     return series;
   };
   invariance.series = {relative_series("flow rate", rates), relative_series("flow rate, Beverloo k·αd corrected (k = 1.5)", corrected),
-                       relative_series(fmt::format("flow rate, corrected with the fitted k = {:.2f}", k_across), corrected_fitted),
-                       relative_series("ring fill, whole cavity", fills), relative_series("ring fill, core (wall layer excluded)", cores)};
+                       relative_series(fmt::format("flow rate, corrected with the fitted k = {:.2f}", k_across), corrected_fitted)};
+  if (fill_ring)
+    invariance.series.insert(invariance.series.end(), {relative_series("ring fill, whole cavity", fills),
+                                                       relative_series("ring fill, core (wall layer excluded)", cores)});
   out.chart(invariance);
   Chart angle_chart{"coarse_graining_repose.png", "Outflow angle of repose against grain size", "grain diameter [mm]", "angle [°]"};
   Series angle_series{"outflow angle (DEM)", {}, {}, {}, "points"};
@@ -215,16 +227,18 @@ void coarse_graining(const PipelineScene& scene_in, bool reduced, Output& out) {
   out.chart(angle_chart);
 
   nlohmann::json factors = nlohmann::json::array();
-  for (const FactorResult& f : results)
-    factors.push_back({{"alpha", f.alpha},
-                       {"grain_diameter_m", f.diameter},
-                       {"slot", {{"grains", f.slot_grains}, {"rate_kg_s", f.rate}, {"rate_error_kg_s", f.rate_error},
-                                 {"beverloo_corrected_rate_kg_s", f.corrected_rate}, {"bulk_density_kg_m3", f.bulk_density},
-                                 {"outflow_angle_deg", f.outflow.angle_deg}, {"outflow_angle_error_deg", f.outflow.error_deg}}},
-                       {"ring", {{"grains_in_cavity", f.cavity_grains}, {"fill_ratio", f.fill_ratio},
-                                 {"core_solid_fraction", f.core_fraction}, {"wall_layer_m", f.wall_layer},
-                                 {"wall_layer_over_d", f.wall_layer / f.diameter}}},
-                       {"wall_s", f.seconds}});
+  for (const FactorResult& f : results) {
+    nlohmann::json factor = {{"alpha", f.alpha},
+                             {"grain_diameter_m", f.diameter},
+                             {"slot", {{"grains", f.slot_grains}, {"rate_kg_s", f.rate}, {"rate_error_kg_s", f.rate_error},
+                                       {"beverloo_corrected_rate_kg_s", f.corrected_rate}, {"bulk_density_kg_m3", f.bulk_density},
+                                       {"outflow_angle_deg", f.outflow.angle_deg}, {"outflow_angle_error_deg", f.outflow.error_deg}}},
+                             {"wall_s", f.seconds}};
+    if (fill_ring)
+      factor["ring"] = {{"grains_in_cavity", f.cavity_grains}, {"fill_ratio", f.fill_ratio}, {"core_solid_fraction", f.core_fraction},
+                        {"wall_layer_m", f.wall_layer}, {"wall_layer_over_d", f.wall_layer / f.diameter}};
+    factors.push_back(factor);
+  }
   const auto target = [](double measured, double goal) { return nlohmann::json{{"measured", measured}, {"target", goal}, {"met", measured <= goal}}; };
   out.results = {
       {"factors", factors},
@@ -239,11 +253,13 @@ void coarse_graining(const PipelineScene& scene_in, bool reduced, Output& out) {
        {{"outflow_angle_range_deg", target(angle_range, target_angle_deg)},
         {"flow_rate_spread", target(spread(rates), target_flow)},
         {"flow_rate_spread_beverloo_corrected", target(spread(corrected), target_flow)},
-        {"flow_rate_spread_beverloo_fitted_k", target(spread(corrected_fitted), target_flow)},
-        {"fill_density_spread", target(spread(fills), target_density)},
-        {"fill_density_spread_core", target(spread(cores), target_density)}}},
-      {"wall_layer_over_d_mean", layer},
-      {"real_powder_fill_ratio_predicted", real_fill}};
+        {"flow_rate_spread_beverloo_fitted_k", target(spread(corrected_fitted), target_flow)}}}};
+  if (fill_ring) {
+    out.results["invariance"]["fill_density_spread"] = target(spread(fills), target_density);
+    out.results["invariance"]["fill_density_spread_core"] = target(spread(cores), target_density);
+    out.results["wall_layer_over_d_mean"] = layer;
+    out.results["real_powder_fill_ratio_predicted"] = real_fill;
+  }
 }
 
 }  // namespace app::study

@@ -104,8 +104,8 @@ TEST(Study, CoarseGrainingKeepsFlowAndReposeOnceTheBoundaryIsCorrected) {
   for (const auto& f : r["factors"]) angles.push_back({f["slot"]["outflow_angle_deg"], f["slot"]["outflow_angle_error_deg"]});
   const auto [low, high] = std::minmax_element(angles.begin(), angles.end());
   EXPECT_LE(high->first - low->first, 2.0 + 2 * std::hypot(high->second, low->second)) << inv.dump();
-  // Not asserted: the ring's fill density. Its annulus is 3 to 6 of these grains wide, far from
-  // the 20 PHYSICS.md §4 asks for; the study reports the spread (about 4 %) and why.
+  // The ring is filled at the default size only: its annulus is 3 to 6 of these grains wide, far
+  // from the 20 PHYSICS.md §4 asks for, so their fill would test no invariance.
 }
 
 // The speed-accuracy sweep on the ring die (1.6 mm grains): the cost laws it rests on, read
