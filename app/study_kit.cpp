@@ -99,9 +99,21 @@ void Output::table(const std::string& file, const std::vector<std::string>& colu
   text += "\n";
   for (const auto& row : rows) {
     for (std::size_t c = 0; c < row.size(); ++c) {
-      // Numbers in full precision; text as is (studies write no commas into it).
+      // Numbers in full precision; text quoted where it holds a comma or a quote (RFC 4180):
+      // labels such as "√2 coarser, stiffness / 10" do.
       text += c ? "," : "";
-      text += row[c].is_string() ? row[c].get<std::string>() : row[c].dump();
+      if (!row[c].is_string()) {
+        text += row[c].dump();
+        continue;
+      }
+      const std::string cell = row[c].get<std::string>();
+      if (cell.find_first_of(",\"\n") == std::string::npos) {
+        text += cell;
+        continue;
+      }
+      text += '"';
+      for (char ch : cell) text += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+      text += '"';
     }
     text += "\n";
   }
