@@ -87,7 +87,7 @@ TEST(Study, ReposeAnglesRiseWithFrictionNearTheZhouCorrelation) {
 }
 
 // Coarse graining (PHYSICS.md §4) at grains of 0.8, 1.13 and 1.6 mm in one slot container (the
-// coarsest five grains across its slot and its length) and the ring die.
+// coarsest five grains across its slot and its length); reduced, the ring die is not filled.
 TEST(Study, CoarseGrainingKeepsFlowAndReposeOnceTheBoundaryIsCorrected) {
   const nlohmann::json r = run_reduced("coarse-graining", {});
   const auto& inv = r["invariance"];
