@@ -25,6 +25,6 @@ class StabilityError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-enum ExitStatus : int { exit_ok = 0, exit_other = 1, exit_bad_input = 2, exit_unstable = 3 };
+enum ExitStatus : int { exit_ok = 0, exit_other = 1, exit_bad_input = 2, exit_unstable = 3, exit_interrupted = 130 };
 
 }  // namespace diefill

@@ -10,7 +10,7 @@
 
 #include "dem/model.hpp"
 #include "dem/state.hpp"
-#include "mesh/clump.hpp"
+#include "mesh/clump_template.hpp"
 
 namespace dem {
 

@@ -9,7 +9,7 @@ namespace dem {
 
 namespace {
 
-constexpr char magic[8] = {'D', 'F', 'C', 'K', 'P', 'T', '0', '2'};
+constexpr char magic[8] = {'D', 'F', 'C', 'K', 'P', 'T', '0', '3'};
 
 struct Writer {
   std::string bytes;
@@ -79,6 +79,7 @@ void fields(IO& io, S& s) {
   io.array(nl.near_wall);
   io.array(nl.x_at_build);
   io.array(nl.wall_shift_at_build);
+  io.value(nl.time_at_build);
   io.value(nl.builds);
   io.value(s.time);
   io.value(s.step);

@@ -9,9 +9,12 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/sha256.hpp"
+#include "dem/dem_source_hash.hpp"
 #include "dem/state.hpp"
 
 namespace dem {
+
+std::string_view source_hash() { return DIEFILL_DEM_SOURCE_HASH; }
 
 using diefill::InputError;
 
@@ -75,6 +78,9 @@ Model compile_model(const ModelSpec& spec, const State& state, const std::string
   for (const MeshWall& w : m.meshes) {
     if (!w.field) throw InputError(source, "walls", "a mesh wall has no distance field", "Give the wall a mesh");
     m.mesh_moves.push_back(w.motion.moves() || w.motion.start_position.squaredNorm() > 0);
+    double reach = 0;
+    for (const Vec3& v : w.field->vertices) reach = std::max(reach, (v - w.motion.pivot).norm());
+    m.mesh_reach.push_back(reach);
   }
 
   // Pairs: Hertz effective moduli; unlike materials mix e, μ and cohesion by the geometric
@@ -156,13 +162,17 @@ Model compile_model(const ModelSpec& spec, const State& state, const std::string
                        source, spec.max_impact_speed, spec.max_impact_speed * m.dt, m.skin);
   // A wall's motion is known exactly, so a wall that could pass grains unseen is refused: the
   // grains near it are listed at a rebuild, and a rebuild comes once it has moved half the skin.
-  for (const MeshWall& w : spec.meshes)
-    if (const double per_step = w.motion.top_speed() * m.dt; per_step > 0.5 * m.skin)
+  // A rotating wall's points move by up to |ω| times their distance from the pivot on top.
+  for (std::size_t k = 0; k < spec.meshes.size(); ++k) {
+    const MeshWall& w = spec.meshes[k];
+    const double top_speed = w.motion.top_speed() + w.motion.angular_velocity.norm() * m.mesh_reach[k];
+    if (const double per_step = top_speed * m.dt; per_step > 0.5 * m.skin)
       throw InputError(source, "walls." + w.name + ".motion",
                        fmt::format("the wall moves {:.3g} m per step at its top speed {:.3g} m/s, more than half the neighbour "
                                    "skin {:.3g} m: it could pass through grains it has not listed",
-                                   per_step, w.motion.top_speed(), m.skin),
+                                   per_step, top_speed, m.skin),
                        "Lower the wall's speed or the time step, or widen simulation.skin");
+  }
   m.cell_size = 2 * m.max_radius + m.skin;
 
   std::string text = fmt::format("dt={:a};skin={:a};g={:a},{:a},{:a};laws={},{},{},{};stop={:a};dom={:a},{:a},{:a},{:a},{:a},{:a}",
@@ -174,9 +184,15 @@ Model compile_model(const ModelSpec& spec, const State& state, const std::string
     text += fmt::format(";{:a},{:a},{:a},{:a},{:a},{:a},{:a}", p.e_star, p.g_star, p.damping, p.mu_s, p.mu_r, p.k_linear, p.cohesion);
   for (const PlaneWall& p : m.planes)
     text += fmt::format(";plane{:a},{:a},{:a},{:a},{:a},{:a},{}", p.point.x(), p.point.y(), p.point.z(), p.normal.x(), p.normal.y(), p.normal.z(), p.material);
-  for (const MeshWall& w : m.meshes)
+  // The walls' motion is part of the model: a checkpoint resumes only under the same one.
+  const auto vec = [](const Vec3& v) { return fmt::format("{:a},{:a},{:a}", v.x(), v.y(), v.z()); };
+  for (const MeshWall& w : m.meshes) {
     text += fmt::format(";mesh{},{},{},{},{:a},{:a}", w.name, w.field->triangles.size(), w.field->voxel, w.material,
                         w.cut_z, w.cut_fraction);
+    text += fmt::format(";motion{};{};{};{}", vec(w.motion.start_position), vec(w.motion.start_velocity),
+                        vec(w.motion.angular_velocity), vec(w.motion.pivot));
+    for (const Motion::Segment& seg : w.motion.segments) text += fmt::format(";{:a},{}", seg.duration, vec(seg.acceleration));
+  }
   m.hash = diefill::sha256_hex(text);
   return m;
 }

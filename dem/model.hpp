@@ -108,6 +108,9 @@ struct Model {
   std::vector<PlaneWall> planes;
   std::vector<MeshWall> meshes;
   std::vector<char> mesh_moves;  // [meshes] whether the wall's motion is not the identity
+  // [meshes] farthest surface point from the wall's pivot [m]: a rotation by θ moves no point of
+  // the wall farther than θ times this.
+  std::vector<double> mesh_reach;
   double stop_overlap;
   std::string hash;             // of every parameter above: checkpoints carry it
 
@@ -116,6 +119,9 @@ struct Model {
   }
   int wall_count() const { return int(planes.size() + meshes.size()); }
 };
+
+// SHA-256 of the dem module's sources, for caches of simulated results.
+std::string_view source_hash();
 
 struct State;
 // Checks the spec (throws diefill::InputError naming `source` and the field), mixes material

@@ -103,10 +103,14 @@ struct OldPair {
 bool needs_rebuild(const Model& model, const State& s, double largest_shift2) {
   const NeighbourList& nl = s.neighbours;
   if (nl.x_at_build.size() != s.size()) return true;
+  // How far any point of a wall has moved since the build: its origin's shift, plus for a
+  // rotating wall the angle turned times its reach from the pivot (an arc bounds its chord).
   double wall_shift = 0;
-  for (std::size_t m = 0; m < model.meshes.size(); ++m)
-    wall_shift = std::max(wall_shift, (model.meshes[m].motion.position(s.time) - nl.wall_shift_at_build[m]).norm());
-  // A rotating wall moves its points by up to |ω| r; the shoe does not rotate, others are fixed.
+  for (std::size_t m = 0; m < model.meshes.size(); ++m) {
+    const Motion& motion = model.meshes[m].motion;
+    const double turned = motion.angular_velocity.norm() * std::abs(s.time - nl.time_at_build) * model.mesh_reach[m];
+    wall_shift = std::max(wall_shift, (motion.position(s.time) - nl.wall_shift_at_build[m]).norm() + turned);
+  }
   return std::sqrt(largest_shift2) + wall_shift > 0.5 * model.skin;
 }
 
@@ -224,6 +228,7 @@ void rebuild_neighbours(const Model& model, State& s) {
   for (std::size_t p = 0; p < pairs; ++p) nl.reverse_pair[std::size_t(fill[std::size_t(nl.partner[p])]++)] = std::int32_t(p);
 
   nl.x_at_build = s.x;
+  nl.time_at_build = s.time;
   nl.wall_shift_at_build.resize(model.meshes.size());
   for (std::size_t m = 0; m < model.meshes.size(); ++m) nl.wall_shift_at_build[m] = model.meshes[m].motion.position(s.time);
   collect_near_wall(model, s);

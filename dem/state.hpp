@@ -40,6 +40,7 @@ struct NeighbourList {
   std::vector<std::int32_t> near_wall;      // particles within range of a wall at build time
   std::vector<Vec3> x_at_build;             // [N] [m]
   std::vector<Vec3> wall_shift_at_build;    // [mesh walls] [m] wall origin at build time
+  double time_at_build = 0;                 // [s]
   std::int64_t builds = 0;
 };
 
@@ -82,6 +83,9 @@ struct StepCounters {
   std::int64_t contacts = 0;    // pair contacts this step
   std::int64_t wall_contacts = 0;
   double wall_power = 0;        // power walls deliver to particles [W]
+  // At the last energy check (every few hundred steps): the mechanical energy beyond what gravity
+  // and the walls can have given, over the energy scale Σ m g r; negative while energy is lost.
+  double energy_gain = 0;
 };
 
 struct State {

@@ -117,6 +117,7 @@ StepReport monitor(const Model& model, State& s) {
   const double energy = kinetic_energy(s) + potential_energy(model, s) + elastic_energy(model, s);
   if (s.energy_reference_set) {
     const double budget = s.energy_reference + s.wall_work;
+    s.counters.energy_gain = (energy - budget) / std::max(s.energy_scale, 1e-300);
     const double slack = 1e-3 * std::abs(s.energy_reference) + 1e-3 * s.energy_scale + 1e-12;
     if (energy > budget + slack) {
       r.status = StepStatus::energy_growth;

@@ -16,7 +16,6 @@ enum class StepStatus { ok, non_finite, overlap, energy_growth };
 
 struct StageTimes {
   double neighbours = 0, pair_forces = 0, sums = 0, wall_forces = 0, integration = 0, monitor = 0;
-  double total() const { return neighbours + pair_forces + sums + wall_forces + integration + monitor; }
 };
 
 struct StepReport {

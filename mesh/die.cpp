@@ -126,7 +126,9 @@ DieOptions die_options_for_grains(double grain_radius_m, double skin_m, std::opt
   DieOptions o;
   o.voxel_m = voxel_m ? *voxel_m : default_voxel_fraction * grain_radius_m;
   o.exterior_band_m = grain_radius_m + skin_m + o.voxel_m;
-  o.interior_band_m = 2.0 * o.voxel_m;
+  // Three voxels inside, as OpenVDB's level sets keep: a trilinear sample 1.5 voxels inside reads
+  // corners up to half a cell diagonal deeper (2.4 voxels), beyond a band of two.
+  o.interior_band_m = 3.0 * o.voxel_m;
   o.repair.tolerance_m = 0.5 * o.voxel_m;
   o.repair.max_hole_m = 10.0 * o.voxel_m;
   return o;
@@ -145,17 +147,30 @@ std::string die_cache_key(const std::string& file_sha256, const DieOptions& o) {
   return diefill::sha256_hex(text);
 }
 
-PreparedDie prepare_die(const fs::path& path, const DieOptions& options,
-                        const std::optional<fs::path>& cache_dir) {
-  const std::string source = path.string();
+DieFile read_die_file(const fs::path& path, LengthUnit unit) {
+  DieFile file;
+  file.source = path.string();
+  file.name = path.stem().string();
+  file.unit = unit;
+  // Import first: it gives the clear message for a missing, empty or unreadable file.
+  file.mesh = import_mesh(path, {unit}).mesh;
+  file.sha256 = diefill::sha256_file(path);
+  return file;
+}
+
+PreparedDie prepare_die(const fs::path& path, const DieOptions& options, const std::optional<fs::path>& cache_dir) {
+  return prepare_die(read_die_file(path, options.unit), options, cache_dir);
+}
+
+PreparedDie prepare_die(const DieFile& file, const DieOptions& options, const std::optional<fs::path>& cache_dir) {
+  const std::string& source = file.source;
   check_options(options, source);
+  if (file.unit != options.unit)
+    throw InputError(source, "units", "the file was read in another unit than the options give", "Read it in the options' unit");
   PreparedDie out;
   out.source = source;
-  out.name = path.stem().string();
-
-  // Import first: it gives the clear message for a missing, empty or unreadable file.
-  ImportResult imported = import_mesh(path, {options.unit});
-  out.sha256 = diefill::sha256_file(path);
+  out.name = file.name;
+  out.sha256 = file.sha256;
   out.cache_key = die_cache_key(out.sha256, options);
 
   if (cache_dir) {
@@ -176,7 +191,7 @@ PreparedDie prepare_die(const fs::path& path, const DieOptions& options,
           out.table_z = meta.at("table_z");
           out.cavity = std::move(*cavity);
           out.solid = std::move(*solid);
-          out.sdf = SdfGrid::read(base.string() + ".vdb");
+          out.sdf = SdfGrid::read_cache(base.string() + ".vdb");
           out.sdf_from_cache = true;
           return out;
         }
@@ -186,7 +201,7 @@ PreparedDie prepare_die(const fs::path& path, const DieOptions& options,
     }
   }
 
-  RepairResult repaired = repair(imported.mesh, options.repair, source);
+  RepairResult repaired = repair(file.mesh, options.repair, source);
   out.before = repaired.before;
   out.after = repaired.after;
   out.actions = repaired.actions;
@@ -224,14 +239,14 @@ PreparedDie prepare_die(const fs::path& path, const DieOptions& options,
   diefill::log::debug("sdf: {} active voxels in {:.2f} s", out.sdf.active_voxels(), clock.seconds());
   out.sdf.set_metadata("role", std::string(role_name(options.role)));
   out.sdf.set_metadata("source_sha256", out.sha256);
-  out.sdf.set_metadata("source", path.filename().string());
+  out.sdf.set_metadata("source", fs::path(source).filename().string());
   out.sdf.set_metadata("table_z_m", fmt::format("{:.17g}", out.table_z));
 
   if (cache_dir) {
     const fs::path base = *cache_dir / out.cache_key;
     write_mesh_binary(out.cavity, base.string() + ".cavity.bin");
     write_mesh_binary(out.solid, base.string() + ".solid.bin");
-    out.sdf.write(base.string() + ".vdb");
+    out.sdf.write_cache(base.string() + ".vdb");
     // The JSON is written last: an entry counts only once all its files are complete.
     const json meta = {{"key", out.cache_key},
                        {"source", source},

@@ -54,14 +54,27 @@ struct PreparedDie {
   std::string cache_key;
 };
 
+// A die's file as read, before any repair: the pipeline reads it once, plans the shoe and sizes
+// the grains from its box, then prepares it with options that depend on them.
+struct DieFile {
+  std::string name;    // file stem
+  std::string source;  // path as given
+  std::string sha256;  // of the file's bytes
+  LengthUnit unit = LengthUnit::mm;
+  TriMesh mesh;        // [m]
+};
+// Throws InputError for a missing, empty or unreadable file.
+DieFile read_die_file(const std::filesystem::path& path, LengthUnit unit);
+
 // Throws InputError for every defect of the file or the options (a die smaller than a few
 // voxels, for instance, usually a mesh in metres read as millimetres).
+PreparedDie prepare_die(const DieFile& file, const DieOptions& options, const std::optional<std::filesystem::path>& cache_dir);
 PreparedDie prepare_die(const std::filesystem::path& path, const DieOptions& options,
                         const std::optional<std::filesystem::path>& cache_dir);
 
 // Voxel and band for grains of largest radius R and neighbour skin s: the voxel is
 // `voxel_fraction` R unless given; the band reaches R + s + one voxel outside the solid (the
-// farthest a grain centre can be and still need the wall) and two voxels inside.
+// farthest a grain centre can be and still need the wall) and three voxels inside.
 DieOptions die_options_for_grains(double grain_radius_m, double skin_m,
                                   std::optional<double> voxel_m = std::nullopt);
 

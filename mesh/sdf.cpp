@@ -45,6 +45,8 @@ struct SdfGrid::Impl {
   openvdb::FloatGrid::Ptr grid;
   openvdb::Int32Grid::Ptr closest;  // index of the closest triangle, per band voxel
   std::map<std::string, std::string> metadata;
+  // A copy of the distance grid named "sdf", with the metadata, the voxel size and the units.
+  openvdb::GridBase::Ptr named_distance(const std::map<std::string, std::string>& meta, double voxel) const;
 };
 
 SdfGrid::SdfGrid() : impl_(std::make_unique<Impl>()) {}
@@ -183,28 +185,44 @@ void SdfGrid::set_metadata(const std::string& key, const std::string& value) {
   impl_->metadata[key] = value;
 }
 
-void SdfGrid::write(const std::filesystem::path& path) const {
-  initialise_openvdb();
-  openvdb::FloatGrid::Ptr grid = impl_->grid->deepCopy();
-  grid->setName("sdf");
-  openvdb::Int32Grid::Ptr closest = impl_->closest->deepCopy();
-  closest->setName("closest_triangle");
-  for (const auto& [key, value] : impl_->metadata) grid->insertMeta(key, openvdb::StringMetadata(value));
-  grid->insertMeta("units", openvdb::StringMetadata("m"));
-  grid->insertMeta("voxel_size_m", openvdb::DoubleMetadata(voxel_size()));
+namespace {
+
+void write_grids(const std::filesystem::path& path, const openvdb::GridPtrVec& grids) {
   diefill::PendingFile pending(path);
   try {
     openvdb::io::File file(pending.path().string());
-    file.write({grid, closest});
+    file.write(grids);
     file.close();
   } catch (const openvdb::Exception& e) {
-    throw diefill::InputError(path.string(), "", std::string("cannot be written: ") + e.what(),
-                              "Check the output folder");
+    throw diefill::InputError(path.string(), "", std::string("cannot be written: ") + e.what(), "Check the output folder");
   }
   pending.commit();
 }
 
-SdfGrid SdfGrid::read(const std::filesystem::path& path) {
+}  // namespace
+
+openvdb::GridBase::Ptr SdfGrid::Impl::named_distance(const std::map<std::string, std::string>& metadata, double voxel) const {
+  openvdb::FloatGrid::Ptr copy = grid->deepCopy();
+  copy->setName("sdf");
+  for (const auto& [key, value] : metadata) copy->insertMeta(key, openvdb::StringMetadata(value));
+  copy->insertMeta("units", openvdb::StringMetadata("m"));
+  copy->insertMeta("voxel_size_m", openvdb::DoubleMetadata(voxel));
+  return copy;
+}
+
+void SdfGrid::write(const std::filesystem::path& path) const {
+  initialise_openvdb();
+  write_grids(path, {impl_->named_distance(impl_->metadata, voxel_size())});
+}
+
+void SdfGrid::write_cache(const std::filesystem::path& path) const {
+  initialise_openvdb();
+  openvdb::Int32Grid::Ptr closest = impl_->closest->deepCopy();
+  closest->setName("closest_triangle");
+  write_grids(path, {impl_->named_distance(impl_->metadata, voxel_size()), closest});
+}
+
+SdfGrid SdfGrid::read_cache(const std::filesystem::path& path) {
   initialise_openvdb();
   SdfGrid out;
   try {

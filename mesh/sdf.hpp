@@ -59,11 +59,14 @@ class SdfGrid {
   const std::map<std::string, std::string>& metadata() const;
   void set_metadata(const std::string& key, const std::string& value);
 
-  // Atomic write of the float grid "sdf" (with its metadata, voxel size and units) and the
-  // Int32 grid "closest_triangle".
+  // Atomic write of the float grid "sdf" (with its metadata, voxel size and units): the user's
+  // file, which any OpenVDB reader opens.
   void write(const std::filesystem::path& path) const;
-  // Throws InputError when the file is unreadable or holds no float grid named "sdf".
-  static SdfGrid read(const std::filesystem::path& path);
+  // The same plus the Int32 grid "closest_triangle", for the mesh stage's cache only (OpenVDB's
+  // Python module refuses a whole file that holds an Int32 grid).
+  void write_cache(const std::filesystem::path& path) const;
+  // Reads what write_cache wrote; throws InputError when the file is unreadable or lacks a grid.
+  static SdfGrid read_cache(const std::filesystem::path& path);
 
   struct Impl;
 

@@ -12,7 +12,7 @@ while [[ $# -gt 0 ]]; do
   case "$1" in
     --build-dir) build_dir="$2"; shift 2 ;;
     # Release flags, to which our own targets add -O0 and the sanitizers (cmake/Warnings.cmake).
-    --sanitize) cmake_args=(-DCMAKE_BUILD_TYPE=Release -DDIEFILL_SANITIZE=ON -DDIEFILL_BUILD_BENCH=OFF); shift ;;
+    --sanitize) cmake_args=(-DCMAKE_BUILD_TYPE=Release -DDIEFILL_SANITIZE=ON); shift ;;
     *) targets+=("$1"); shift ;;
   esac
 done
@@ -22,7 +22,8 @@ packages=(
   libcgal-dev libassimp-dev libembree-dev libeigen3-dev libopenvdb-dev libtbb-dev libgtest-dev
   libboost-iostreams-dev                    # OpenVDB needs it; its package does not pull it in
   libtomlplusplus-dev nlohmann-json3-dev libfmt-dev libcli11-dev zlib1g-dev
-  python3-openvdb python3-numpy libopenvdb-tools   # an independent reader for the .vdb tests
+  python3-openvdb python3-numpy libopenvdb-tools   # independent readers of our outputs in the tests:
+  python3-vtk9 python3-meshio                     # OpenVDB, VTK and meshio, not our code
   python3-matplotlib                        # the pictures of reports and studies
 )
 missing=()

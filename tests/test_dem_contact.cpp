@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include "dem/contact.hpp"
@@ -147,4 +148,177 @@ TEST(Friction, SlidingSphereEndsRollingAtFiveSevenths) {
   for (int n = 0; n < steps; ++n) dem::step(model, s);
   EXPECT_NEAR(s.v[0].x() / v0, 5.0 / 7.0, 0.01 * 5.0 / 7.0);
   EXPECT_NEAR(s.w[0].y() * r / s.v[0].x(), 1.0, 0.01) << "rolling without slip";
+}
+
+// ---- the laws no impact test reaches: rolling resistance, cohesion, sticking friction --------
+// One glass sphere (r = 1 mm, E = 1e8 Pa, ν = 0.25) on a rigid floor, each law against its
+// closed form (PHYSICS.md §2).
+
+namespace {
+
+constexpr double grain_r = 1e-3, grain_E = 1e8, grain_nu = 0.25, grain_rho = 2500, g = 9.81;
+const double grain_m = grain_rho * 4.0 / 3.0 * std::numbers::pi * grain_r * grain_r * grain_r;
+const double grain_I = 0.4 * grain_m * grain_r * grain_r;
+// Sphere against a rigid wall: E* = E/(1-ν²), G* = G/(2-ν), R* = r, m* = m.
+const double wall_e_star = grain_E / (1 - grain_nu * grain_nu);
+const double wall_g_star = grain_E / (2 * (1 + grain_nu)) / (2 - grain_nu);
+
+// Hertz overlap [m] carrying a normal force F against the wall.
+double hertz_overlap(double force) { return std::pow(force / (4.0 / 3.0 * wall_e_star * std::sqrt(grain_r)), 2.0 / 3.0); }
+
+struct Floor {
+  dem::Model model;
+  dem::State s;
+};
+
+// The sphere resting on the floor at the overlap that carries its weight, moving at v and
+// spinning at w; both materials have restitution e, friction mu and rolling friction mu_r.
+Floor sphere_on_floor(dem::RollingLaw rolling, double e, double mu, double mu_r, const Vec3& v, const Vec3& w,
+                      double step_fraction = 0.15) {
+  dem::Material grain = test::glass(e, mu), wall = test::rigid_wall(e, mu);
+  grain.rolling_friction = wall.rolling_friction = mu_r;
+  dem::ModelSpec spec = test::spec_with({grain, wall}, Vec3(0, 0, -g));
+  spec.planes.push_back({Vec3::Zero(), Vec3::UnitZ(), 1, "floor"});
+  spec.rolling = rolling;
+  spec.time_step_fraction = step_fraction;
+  Floor f{dem::Model{}, dem::State{}};
+  f.s.add_sphere(0, Vec3(0, 0, grain_r - hertz_overlap(grain_m * g)), grain_r, grain_rho, 0, v, w);
+  f.model = dem::compile_model(spec, f.s, "test");
+  dem::initialize(f.model, f.s);
+  return f;
+}
+
+// The lower and upper squared frequencies of a sphere held at its contact by a tangential spring
+// k_t (at arm `arm` below the centre) and a rolling spring k_r: coordinates x (centre) and θ
+// (rotation), M = diag(m, I), K = [[k_t, -k_t arm], [-k_t arm, k_t arm² + k_r]].
+std::pair<double, double> contact_modes(double k_t, double k_r, double arm) {
+  const double a = grain_m * grain_I, b = grain_m * (k_t * arm * arm + k_r) + grain_I * k_t, c = k_t * k_r;
+  const double root = std::sqrt(b * b - 4 * a * c);
+  return {(b - root) / (2 * a), (b + root) / (2 * a)};
+}
+
+// Period of a signal from its first and last upward zero crossings (linearly interpolated).
+template <class Step, class Signal>
+double period_of(Step&& step, Signal&& signal, double dt, int crossings) {
+  double previous = signal(), first = -1, last = -1, t = 0;
+  int seen = 0;
+  while (seen <= crossings) {
+    step();
+    t += dt;
+    const double now = signal();
+    if (previous < 0 && now >= 0) {
+      last = t - dt * now / (now - previous);
+      if (seen == 0) first = last;
+      ++seen;
+    }
+    previous = now;
+  }
+  return (last - first) / crossings;
+}
+
+// Velocity of the sphere's centre after rolling freely from t1 to t2, decelerated by a rolling
+// torque μ_r R F_n: without slip, (m + I/R²) a = μ_r F_n, so a = (5/7) μ_r g.
+double rolling_deceleration(dem::RollingLaw law, double mu_r, double v0) {
+  Floor f = sphere_on_floor(law, 0.5, 0.5, mu_r, Vec3(v0, 0, 0), Vec3(0, v0 / grain_r, 0));
+  auto run_to = [&](double t) {
+    while (f.s.time < t) {
+      EXPECT_EQ(dem::step(f.model, f.s).status, dem::StepStatus::ok);
+    }
+    return std::pair{f.s.time, f.s.v[0].x()};
+  };
+  const auto [t1, v1] = run_to(0.01);
+  const auto [t2, v2] = run_to(0.04);
+  return (v1 - v2) / (t2 - t1);
+}
+
+}  // namespace
+
+TEST(Rolling, ConstantDirectionalTorqueDeceleratesARollingSphereAsTheClosedForm) {
+  const double mu_r = 0.1;
+  const double ratio = rolling_deceleration(dem::RollingLaw::cdt, mu_r, 0.05) / (5.0 / 7.0 * mu_r * g);
+  std::printf("CDT: deceleration / (5/7 mu_r g) = %.5f\n", ratio);
+  EXPECT_NEAR(ratio, 1.0, 0.01);
+}
+
+TEST(Rolling, ElasticPlasticSpringRocksAtItsStiffnessAndSlidesAtItsLimit) {
+  const double mu_r = 0.1, overlap = hertz_overlap(grain_m * g);
+  // Below the limit: k_r = 2.25 S_n μ_r² R*², S_n = 2 E* a, with the tangential spring
+  // k_t = 8 G* a in series at the contact (a = sqrt(R δ)); the sphere rocks in the lower mode.
+  const double a = std::sqrt(grain_r * overlap), s_n = 2 * wall_e_star * a;
+  const double k_r = 2.25 * s_n * mu_r * mu_r * grain_r * grain_r, k_t = 8 * wall_g_star * a;
+  const double rocking = std::sqrt(contact_modes(k_t, k_r, grain_r - overlap).first);
+  // Amplitude a tenth of the limit: the spring's torque k_r θ stays below μ_r R F_n.
+  const double w0 = 0.1 * (mu_r * grain_r * grain_m * g / k_r) * rocking;
+  Floor f = sphere_on_floor(dem::RollingLaw::epsd, 1.0, 0.5, mu_r, Vec3(w0 * grain_r, 0, 0), Vec3(0, w0, 0), 0.05);
+  const double period = period_of([&] { dem::step(f.model, f.s); }, [&] { return -f.s.w[0].y(); }, f.model.dt, 10);
+  const double limit = rolling_deceleration(dem::RollingLaw::epsd, mu_r, 0.05) / (5.0 / 7.0 * mu_r * g);
+  std::printf("EPSD: rocking period / closed form = %.5f; deceleration at the limit / (5/7 mu_r g) = %.5f\n",
+              period / (2 * std::numbers::pi / rocking), limit);
+  EXPECT_NEAR(period / (2 * std::numbers::pi / rocking), 1.0, 0.01);
+  // Beyond it the torque stays at its limit: the deceleration of the constant torque.
+  EXPECT_NEAR(limit, 1.0, 0.01);
+}
+
+TEST(Friction, MindlinSpringSticksWithStiffnessEightGStarA) {
+  // Elastic (e = 1): the sphere, nudged sideways, oscillates on its tangential spring in the
+  // upper contact mode (no rolling spring: ω² = k_t (1/m + arm²/I)).
+  const double mu = 0.5, overlap = hertz_overlap(grain_m * g);
+  const double k_t = 8 * wall_g_star * std::sqrt(grain_r * overlap);
+  const double omega = std::sqrt(contact_modes(k_t, 0, grain_r - overlap).second);
+  // Sticking: the spring's force k_t v0/ω stays at a fifth of the Coulomb cap μ m g.
+  const double v0 = 0.2 * mu * grain_m * g * omega / k_t;
+  Floor f = sphere_on_floor(dem::RollingLaw::none, 1.0, mu, 0, Vec3(v0, 0, 0), Vec3::Zero(), 0.01);
+  const double period = period_of([&] { dem::step(f.model, f.s); }, [&] { return -f.s.f[0].x(); }, f.model.dt, 10);
+  const double measured_k_t = k_t * std::pow(2 * std::numbers::pi / period / omega, 2);
+  std::printf("Mindlin: sticking stiffness / (8 G* a) = %.5f\n", measured_k_t / k_t);
+  EXPECT_NEAR(measured_k_t / k_t, 1.0, 0.01);
+}
+
+namespace {
+
+// The sphere against the floor with cohesion k [J/m³] (both materials), gravity g_up pulling it
+// away from the floor, starting at `overlap` at rest.
+Floor cohesive_sphere(double k, double g_up, double overlap) {
+  dem::Material grain = test::glass(0.5, 0.5), wall = test::rigid_wall(0.5, 0.5);
+  grain.cohesion_energy_density = wall.cohesion_energy_density = k;
+  dem::ModelSpec spec = test::spec_with({grain, wall}, Vec3(0, 0, g_up));
+  spec.planes.push_back({Vec3::Zero(), Vec3::UnitZ(), 1, "floor"});
+  spec.cohesion = dem::CohesionLaw::sjkr;
+  Floor f{dem::Model{}, dem::State{}};
+  f.s.add_sphere(0, Vec3(0, 0, grain_r - overlap), grain_r, grain_rho, 0);
+  f.model = dem::compile_model(spec, f.s, "test");
+  dem::initialize(f.model, f.s);
+  return f;
+}
+
+}  // namespace
+
+TEST(Cohesion, SjkrSettlesAtItsEquilibriumOverlapAndLetsGoAtThePullOffForce) {
+  // F(δ) = (4/3) E* √R δ^{3/2} − k π R δ: zero at δ_eq = (3 k π √R / (4 E*))², least (most
+  // attractive) at δ* = (k π √R / (2 E*))², where the pull-off force is k π R δ* / 3.
+  const double delta_eq = 1e-6;
+  const double k = 4 * wall_e_star * std::sqrt(delta_eq) / (3 * std::numbers::pi * std::sqrt(grain_r));
+  const double delta_star = std::pow(k * std::numbers::pi * std::sqrt(grain_r) / (2 * wall_e_star), 2);
+  const double pull_off = k * std::numbers::pi * grain_r * delta_star / 3;
+  {
+    Floor f = cohesive_sphere(k, 0, 0.5 * delta_eq);
+    for (int n = 0; n < 20000; ++n) dem::step(f.model, f.s);
+    std::printf("SJKR: equilibrium overlap / closed form = %.5f\n", (grain_r - f.s.x[0].z()) / delta_eq);
+    EXPECT_NEAR((grain_r - f.s.x[0].z()) / delta_eq, 1.0, 0.01);
+  }
+  // Pulled by 98 % of the pull-off force it holds at the stable root of F(δ) = −F; by 102 % it
+  // has no equilibrium and lets go (started at δ*, the last overlap that could hold it).
+  const auto holds = [&](double fraction, double start) {
+    Floor f = cohesive_sphere(k, fraction * pull_off / grain_m, start);
+    for (int n = 0; n < 20000; ++n) dem::step(f.model, f.s);
+    return f.s.x[0].z() < grain_r;
+  };
+  double stable = delta_eq;  // bisection on [δ*, δ_eq] for F(δ) = −0.98 F_pull
+  for (double lo = delta_star, hi = delta_eq, n = 0; n < 100; ++n) {
+    stable = 0.5 * (lo + hi);
+    const double force = 4.0 / 3.0 * wall_e_star * std::sqrt(grain_r) * std::pow(stable, 1.5) - k * std::numbers::pi * grain_r * stable;
+    (force < -0.98 * pull_off ? lo : hi) = stable;
+  }
+  EXPECT_TRUE(holds(0.98, stable));
+  EXPECT_FALSE(holds(1.02, delta_star));
 }

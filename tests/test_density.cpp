@@ -5,7 +5,7 @@
 #include <numbers>
 #include <random>
 
-#include "app/density_stage.hpp"
+#include "pipeline/density_stage.hpp"
 #include "mesh/die.hpp"
 #include "postprocess/density.hpp"
 #include "postprocess/field.hpp"

@@ -11,9 +11,9 @@
 #include <map>
 #include <sstream>
 
-#include "app/pipeline.hpp"
+#include "pipeline/die_fill.hpp"
 #include "core/error.hpp"
-#include "app/pipeline_scene.hpp"
+#include "scene/pipeline_scene.hpp"
 #include "dem/io.hpp"
 #include "mesh/import.hpp"
 #include "mesh/shapes.hpp"
@@ -145,6 +145,46 @@ TEST(Pipeline, RingFieldIsMirrorSymmetricWithinTheSeedNoise) {
   EXPECT_LE(0.5 * (mirror_one + mirror_two), 1.25 * seed_noise);
 }
 
+// The outputs as other tools read them: OpenVDB's Python module, VTK and meshio (not our code),
+// against the report, the die file's own SHA-256 and the particle file.
+TEST(Pipeline, OutputsReadBackThroughOtherToolsWithTheRightValues) {
+  const nlohmann::json& r = run("ring", 0.1, 1);
+  const std::string command = "/usr/bin/python3 " + (test::source_dir() / "tests" / "read_outputs.py").string() + " " +
+                              output_of("ring").string() + " " + bundled_die("ring").string() + " 2>&1";
+  const test::Run py = test::run_command(command);
+  ASSERT_EQ(py.status, 0) << py.output;
+  const nlohmann::json j = nlohmann::json::parse(py.output);
+  EXPECT_EQ(j["vdb_names"], nlohmann::json({"cavity_fraction", "density", "solid_fraction"}));
+  EXPECT_EQ(j["vdb_metadata"]["die_sha256"], j["die_sha256"]);
+  EXPECT_EQ(j["vdb_metadata"]["die"], "ring");
+  EXPECT_EQ(j["vdb_metadata"]["coarse_graining"], "16");
+  EXPECT_EQ(j["vdb_metadata"]["units"], "m");
+  EXPECT_EQ(j["vdb_metadata"]["method"], "exact");
+  // The default density voxel is two grain diameters.
+  EXPECT_DOUBLE_EQ(j["vdb_voxel_m"].get<double>(), 2 * r["powder"]["grain_diameter_m"].get<double>());
+  EXPECT_NEAR(j["vti_spacing_m"].get<double>(), j["vdb_voxel_m"].get<double>(), 1e-12);
+  // The cavity and its mean solid fraction as the report has them (float32 grids: 1e-6 relative).
+  EXPECT_NEAR(j["vdb_cavity_volume_m3"].get<double>(), r["fill"]["cavity_volume_m3"].get<double>(),
+              1e-6 * r["fill"]["cavity_volume_m3"].get<double>());
+  EXPECT_NEAR(j["vdb_solid_fraction_mean"].get<double>(), r["fill"]["solid_fraction_mean"].get<double>(), 1e-6);
+  EXPECT_EQ(j["vti_arrays"], nlohmann::json({"cavity_fraction", "density", "solid_fraction"}));
+  EXPECT_LT(j["vti_vdb_max_difference"].get<double>(), 1e-5);  // six significant digits in the VTI
+  EXPECT_EQ(j["vtu_points"], r["particles"]["inserted"]);
+  EXPECT_EQ(j["csv_rows"], r["particles"]["inserted"]);
+  // The VTU keeps nine significant digits (half a unit in the ninth of 1 mm and 30 mm).
+  EXPECT_LT(j["vtu_csv_max_radius_difference"].get<double>(), 5e-12);
+  EXPECT_LT(j["vtu_csv_max_position_difference"].get<double>(), 1.5e-10);
+}
+
+// Results do not depend on the thread count: the shoe settled and moved on two threads ends in
+// the very state (every position, velocity and contact history) one thread gives.
+TEST(Pipeline, TwoThreadsGiveTheSameStateAndGrainsAsOne) {
+  const nlohmann::json& one = run("ring", 0.1, 1, "a");
+  const nlohmann::json& two = run("ring", 0.1, 1, "two_threads", coarse + " simulation.threads=2");
+  EXPECT_EQ(one["final_state_sha256"], two["final_state_sha256"]);
+  EXPECT_EQ(read_text(output_of("ring", "a") / "particles.csv"), read_text(output_of("ring", "two_threads") / "particles.csv"));
+}
+
 // PHYSICS.md §3: below the critical speed the cavity fills to the powder's poured density; above
 // it less and less powder has time to fall in. Grains of 1.2 mm: the layer of looser packing
 // along the cavity's walls (about a quarter diameter thick) costs 0.6 x 1.2 x 0.25 x A/V = 0.07
@@ -237,13 +277,15 @@ TEST(Pipeline, ShoeFromAMeshFillsLikeTheBox) {
 }
 
 // Ctrl-C during the fill keeps a checkpoint; `run --resume` finishes from it with the same
-// result as an uninterrupted run (bit for bit: the same report, timings aside).
+// result as an uninterrupted run, bit for bit: the same report (timings aside), final state and
+// grains.
 TEST(Pipeline, InterruptedRunResumesToTheSameResult) {
   test::TempDir dir;
   const std::string args = "run " + bundled_die("ring").string() + " --out " + dir.path().string() + " --set " + coarse;
   const test::Run whole = test::run_diefill(args);
   ASSERT_EQ(whole.status, 0) << whole.output;
   nlohmann::json expected = nlohmann::json::parse(test::read_text(dir / "ring" / "report.json"));
+  const std::string expected_grains = test::read_text(dir / "ring" / "particles.csv");
   // The die and the settled shoe are cached now: the fill starts within a second or two, and
   // lasts over ten.
   const fs::path status = dir / "status";
@@ -261,6 +303,8 @@ TEST(Pipeline, InterruptedRunResumesToTheSameResult) {
   nlohmann::json got = nlohmann::json::parse(test::read_text(dir / "ring" / "report.json"));
   expected.erase("timing"), got.erase("timing");
   EXPECT_EQ(got.dump(), expected.dump());
+  EXPECT_EQ(got["final_state_sha256"], expected["final_state_sha256"]);
+  EXPECT_EQ(test::read_text(dir / "ring" / "particles.csv"), expected_grains);
 }
 
 // Above the critical speed one pass leaves the die short; going back and forth gives the powder

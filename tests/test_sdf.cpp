@@ -96,12 +96,12 @@ TEST(Sdf, CacheIsKeyedByContentAndParameters) {
   EXPECT_NE(changed.cache_key, first.cache_key);
 }
 
-TEST(Sdf, WrittenGridReadsBackWithMetadata) {
+TEST(Sdf, CachedGridReadsBackWithMetadata) {
   test::TempDir dir;
   const mesh::PreparedDie die =
       mesh::prepare_die(test::source_dir() / "dies" / "ring.stl", default_options(), std::nullopt);
-  die.sdf.write(dir / "ring.vdb");
-  const mesh::SdfGrid back = mesh::SdfGrid::read(dir / "ring.vdb");
+  die.sdf.write_cache(dir / "ring.vdb");
+  const mesh::SdfGrid back = mesh::SdfGrid::read_cache(dir / "ring.vdb");
   EXPECT_EQ(back.active_voxels(), die.sdf.active_voxels());
   EXPECT_DOUBLE_EQ(back.voxel_size(), die.sdf.voxel_size());
   EXPECT_EQ(back.metadata().at("units"), "m");

@@ -1,7 +1,7 @@
-// The reduced studies (`diefill study NAME --reduced`, 1.6 mm grains unless a test says
-// otherwise): each runs end to end and
-// checks the law it is about. Tolerances are statistical (two standard errors of the study's own
-// fits) or come from PHYSICS.md's stated ranges; each says which.
+// The studies (`diefill study NAME`, reduced with 1.6 mm grains unless a test says otherwise): each
+// runs end to end and checks the law it is about against a reference that does not come from
+// the study's own output (a published range, the law's own prediction, a fixed tolerance from the
+// literature); a fitted value meets a range only with its whole error bar inside.
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
@@ -12,40 +12,46 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/commands.hpp"
+#include "studies/studies.hpp"
 #include "support.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-nlohmann::json run_reduced(const std::string& name, std::vector<std::string> overrides = {"powder.coarse_graining=16"}) {
+nlohmann::json run_study(const std::string& name, bool reduced, std::vector<std::string> overrides) {
   const fs::path out = fs::temp_directory_path() / fmt::format("diefill-study-{}-{}", name, ::getpid());
   fs::remove_all(out);
-  app::StudyCommand c;
+  app::study::StudyRequest c;
   c.name = name;
-  c.reduced = true;
+  c.reduced = reduced;
   c.out = out;
   c.overrides = std::move(overrides);
-  EXPECT_EQ(app::run_study(c), 0);
+  EXPECT_EQ(app::study::run_study(c), 0);
   std::ifstream in(out / name / (name + ".json"));
   return nlohmann::json::parse(in);
 }
 
-// Whether x lies within `sigmas` standard errors of the interval [lo, hi].
-bool consistent_with(double x, double error, double lo, double hi, double sigmas = 2) {
-  return x + sigmas * error >= lo && x - sigmas * error <= hi;
+nlohmann::json run_reduced(const std::string& name, std::vector<std::string> overrides = {"powder.coarse_graining=16"}) {
+  return run_study(name, true, std::move(overrides));
 }
 
+// Whether the error bar x ± error lies inside [lo, hi]: a reference range is met when the whole
+// bar is in it, so that a noisier study cannot pass more easily.
+bool inside(double x, double error, double lo, double hi) { return x - error >= lo && x + error <= hi; }
+
+// Discharge, reduced: the slot at its full layout with the scene's 0.8 mm grains (five widths of
+// 5-12 grains, a container ten grains wide), the moving shoe with 1.6 mm grains.
 TEST(Study, DischargeFollowsTheBeverlooSlotLawAndTheCriticalVelocityLaw) {
-  const nlohmann::json r = run_reduced("discharge");
+  const nlohmann::json r = run_reduced("discharge", {});
   const auto& bev = r["slot"]["beverloo"];
-  // The slot law describes the measured rates: three widths, two parameters, residuals a few %.
+  // The slot law describes the measured rates: five widths, two parameters, residuals a few %.
   EXPECT_LT(bev["rms_relative_residual"].get<double>(), 0.05);
-  // PHYSICS.md §3: C_s about 1 (taken as 0.75-1.25), k 1.4-2.9 for spheres; the fit from three
-  // widths of a small container is uncertain, so agreement within two standard errors.
-  EXPECT_TRUE(consistent_with(bev["C_s"], bev["C_s_error"], 0.75, 1.25)) << bev.dump();
-  EXPECT_TRUE(consistent_with(bev["k"], bev["k_error"], 1.4, 2.9)) << bev.dump();
+  // Published ranges: k 1.3-2.9 (Beverloo et al. 1961; Nedderman 1992); for the slot form
+  // C_s = 1.03 (Myers & Sellers, quoted by Nedderman 1992, ch. 10) within the relative spread of
+  // the circular form's published 0.55-0.65 (±8 %): 0.95-1.11.
+  EXPECT_TRUE(inside(bev["C_s"], bev["C_s_error"], 0.95, 1.11)) << bev.dump();
+  EXPECT_TRUE(inside(bev["k"], bev["k_error"], 1.3, 2.9)) << bev.dump();
   // The flow rate grows with the slot.
   const auto rates = r["slot"]["rates_kg_s"].get<std::vector<double>>();
   EXPECT_TRUE(std::is_sorted(rates.begin(), rates.end()));
@@ -54,17 +60,20 @@ TEST(Study, DischargeFollowsTheBeverlooSlotLawAndTheCriticalVelocityLaw) {
   EXPECT_TRUE(shoe["delivered_mass_falls_above_v_c"].get<bool>()) << shoe.dump();
   const auto& critical = shoe["critical_velocity"];
   EXPECT_GE(critical["points"].get<int>(), 3);
-  // Above v_c the delivered mass falls as v^-n; the moving-container law gives n = 1 and
-  // die-filling experiments 1-2 (PHYSICS.md §3): within two standard errors of that range.
-  EXPECT_TRUE(consistent_with(critical["n"], critical["n_error"], 1.0, 2.0)) << critical.dump();
-  EXPECT_GT(critical["v_c_m_s"].get<double>(), 0.0);
+  // docs/PHYSICS.md §3: v_c typically 0.05-0.4 m/s for free-flowing metal powders. Above it the
+  // moving-container law, a steady rate through the opening for the time it is exposed (∝ 1/v),
+  // gives n = 1 exactly; experiments report 1-2, the excess from rates that build up. The DEM has
+  // the law's idealisation (a free-flowing powder, no air): n = 1 within 0.3, the lower third of
+  // the experiments' spread.
+  EXPECT_TRUE(inside(critical["v_c_m_s"], critical["v_c_error_m_s"], 0.05, 0.4)) << critical.dump();
+  EXPECT_TRUE(inside(critical["n"], critical["n_error"], 0.7, 1.3)) << critical.dump();
   EXPECT_LT(critical["v_c_m_s"].get<double>(), shoe["speeds_m_s"][1].get<double>());
 }
 
 // Repose (1.6 mm grains; the scene's powder, μ = 0.5 and μ_r = 0.1, then less sliding and no
 // rolling friction): both angles rise with either friction by more than two combined standard
-// errors. Zhou et al.'s correlation is a trend from another bench (PHYSICS.md §3), so the
-// scene's angles need only lie within 5° of it, plus two standard errors.
+// errors (a test of a difference, so its errors belong in it). Zhou et al.'s correlation is a
+// trend from another bench (PHYSICS.md §3), so the scene's angles need only lie within 5° of it.
 TEST(Study, ReposeAnglesRiseWithFrictionNearTheZhouCorrelation) {
   const nlohmann::json r = run_reduced("repose");
   const auto run_with = [&](double sliding, double rolling) {
@@ -81,13 +90,12 @@ TEST(Study, ReposeAnglesRiseWithFrictionNearTheZhouCorrelation) {
                 2 * std::hypot(scene[error].get<double>(), (*lower)[error].get<double>()))
           << angle << ": " << scene.dump() << " against " << lower->dump();
     }
-    EXPECT_NEAR(scene[value].get<double>(), scene["zhou_angle_deg"].get<double>(), 5 + 2 * scene[error].get<double>())
-        << angle << ": " << scene.dump();
+    EXPECT_NEAR(scene[value].get<double>(), scene["zhou_angle_deg"].get<double>(), 5.0) << angle << ": " << scene.dump();
   }
 }
 
-// Coarse graining (PHYSICS.md §4) at grains of 0.8, 1.13 and 1.6 mm in one slot container (the
-// coarsest five grains across its slot and its length); reduced, the ring die is not filled.
+// Coarse graining (PHYSICS.md §4) at grains of 0.57, 0.8 and 1.13 mm in one slot container (the
+// coarsest five grains across its slot); reduced, the ring die is not filled.
 TEST(Study, CoarseGrainingKeepsFlowAndReposeOnceTheBoundaryIsCorrected) {
   const nlohmann::json r = run_reduced("coarse-graining", {});
   const auto& inv = r["invariance"];
@@ -99,11 +107,11 @@ TEST(Study, CoarseGrainingKeepsFlowAndReposeOnceTheBoundaryIsCorrected) {
   const double k = r["settings"]["beverloo_k_that_makes_the_rates_one_law"];
   EXPECT_GE(k, 1.4);
   EXPECT_LE(k, 2.9);
-  // Outflow angles within the seed study's 2°, allowing two standard errors of the extreme pair.
-  std::vector<std::pair<double, double>> angles;
-  for (const auto& f : r["factors"]) angles.push_back({f["slot"]["outflow_angle_deg"], f["slot"]["outflow_angle_error_deg"]});
+  // Outflow angles within the seed study's 2°.
+  std::vector<double> angles;
+  for (const auto& f : r["factors"]) angles.push_back(f["slot"]["outflow_angle_deg"]);
   const auto [low, high] = std::minmax_element(angles.begin(), angles.end());
-  EXPECT_LE(high->first - low->first, 2.0 + 2 * std::hypot(high->second, low->second)) << inv.dump();
+  EXPECT_LE(*high - *low, 2.0) << r["factors"].dump();
   // The ring is filled at the default size only: its annulus is 3 to 6 of these grains wide, far
   // from the 20 PHYSICS.md §4 asks for, so their fill would test no invariance.
 }
@@ -140,26 +148,24 @@ TEST(Study, SpeedAccuracySweepFollowsTheCostLaws) {
   EXPECT_EQ(r["budgets"].size(), 3u);
 }
 
-// Cross-validation (1.6 mm grains): calibrated on the outflow angle, the rolling friction comes
-// out as the scene's and predicts the flow rate; calibrated on the flow rate, it predicts the
-// angle. Agreement means within two combined standard errors (the observation's and the maps'
-// scatter, propagated through the calibration).
+// Cross-validation at the default size (0.8 mm grains, six rolling frictions; the reduced 1.6 mm
+// version calibrated μ_r = -0.08 on the flow for a true 0.1): calibrated on the outflow angle,
+// rolling friction comes out as the scene's and predicts the flow rate; calibrated on the flow
+// rate, it predicts the angle. Tolerances fixed beforehand, not from the study's own errors: 3° in
+// angle (about the spread of repeated angle-of-repose tests on one powder) and 10 % in flow
+// rate; μ_r within ±0.05 of the truth, half the scene's value.
 TEST(Study, CrossValidationPredictsFlowFromReposeAndReposeFromFlow) {
-  const nlohmann::json r = run_reduced("cross-validation");
+  const nlohmann::json r = run_study("cross-validation", false, {});
   const auto& angle_map = r["maps"]["angle_deg"];
   // The angle rises with rolling friction (Zhou et al.'s trend), clearly: else nothing calibrates.
   EXPECT_GT(angle_map["slope"].get<double>(), 2 * angle_map["slope_error"].get<double>()) << angle_map.dump();
-  const auto& on_angle = r["calibrated_on_angle"];
-  EXPECT_NEAR(on_angle["rolling_friction"].get<double>(), r["true_rolling_friction"].get<double>(),
-              2 * on_angle["rolling_friction_error"].get<double>())
-      << on_angle.dump();
-  for (const char* direction : {"calibrated_on_angle", "calibrated_on_flow"}) {
-    const auto& c = r[direction];
-    const auto& p = c.contains("rate_kg_s") ? c["rate_kg_s"] : c["angle_deg"];
-    EXPECT_NEAR(p["predicted"].get<double>(), p["observed"].get<double>(),
-                2 * std::hypot(p["predicted_error"].get<double>(), p["observed_error"].get<double>()))
-        << direction << ": " << c.dump();
-  }
+  const double truth = r["true_rolling_friction"];
+  for (const char* direction : {"calibrated_on_angle", "calibrated_on_flow"})
+    EXPECT_NEAR(r[direction]["rolling_friction"].get<double>(), truth, 0.05) << direction << ": " << r[direction].dump();
+  const auto& flow = r["calibrated_on_angle"]["rate_kg_s"];
+  EXPECT_NEAR(flow["predicted"].get<double>() / flow["observed"].get<double>(), 1.0, 0.10) << flow.dump();
+  const auto& angle = r["calibrated_on_flow"]["angle_deg"];
+  EXPECT_NEAR(angle["predicted"].get<double>(), angle["observed"].get<double>(), 3.0) << angle.dump();
 }
 
 // Each method probed below and beyond its limit: below, the run passes its checks and its

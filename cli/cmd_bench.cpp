@@ -1,0 +1,239 @@
+// `diefill bench`: performance cases with machine-readable results (JSON on stdout or --json).
+//   ring-10k, ring-100k   settled dense packs of monodisperse spheres in the ring die
+//   liggghts              the LIGGGHTS reference scene (../shared/bench/liggghts): the same
+//                         settled pack, container mesh, contact law and time step
+//   run-ring              `diefill run dies/ring.stl` with the default scene, from nothing (no
+//                         cached die or shoe): the user's wait, stage by stage
+// The particle cases are timed on 1 and 2 threads (or --threads), after a warm-up.
+#include <fmt/core.h>
+#include <omp.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "cli/commands.hpp"
+#include "pipeline/die_fill.hpp"
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "core/resources.hpp"
+#include "core/log.hpp"
+#include "core/timer.hpp"
+#include "dem/insert.hpp"
+#include "dem/io.hpp"
+#include "dem/step.hpp"
+#include "mesh/die.hpp"
+
+namespace app {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+// The LIGGGHTS reference material: d = 1 mm, 2500 kg/m³, E = 5 MPa, ν = 0.3, e = 0.5, μ = 0.5,
+// constant directional torque rolling resistance 0.1 (in/common.in).
+dem::Material reference_material() {
+  dem::Material m;
+  m.name = "reference";
+  m.density = 2500;
+  m.youngs_modulus = 5e6;
+  m.poisson_ratio = 0.3;
+  m.restitution = 0.5;
+  m.sliding_friction = 0.5;
+  m.rolling_friction = 0.1;
+  return m;
+}
+
+dem::ModelSpec reference_spec() {
+  dem::ModelSpec spec;
+  spec.materials = {reference_material()};
+  spec.normal = dem::NormalLaw::hertz;
+  spec.tangential = dem::TangentialLaw::mindlin;
+  spec.rolling = dem::RollingLaw::cdt;
+  spec.time_step = 1e-6;       // as bench.in
+  spec.skin = 0.25e-3;         // "neighbor 0.00025 bin"
+  spec.max_impact_speed = 0.5;
+  return spec;
+}
+
+// LAMMPS "dump custom" with columns id x y z radius vx vy vz.
+dem::State read_lammps_dump(const fs::path& path, const dem::Material& m) {
+  std::ifstream in(path);
+  if (!in) throw diefill::InputError(path.string(), "", "cannot be read", "Run the LIGGGHTS preparation first (bench/compare_liggghts.sh)");
+  std::string line;
+  std::vector<std::string> columns;
+  while (std::getline(in, line))
+    if (line.rfind("ITEM: ATOMS", 0) == 0) {
+      std::istringstream names(line.substr(11));
+      for (std::string c; names >> c;) columns.push_back(c);
+      break;
+    }
+  auto col = [&](const std::string& name) {
+    for (std::size_t c = 0; c < columns.size(); ++c)
+      if (columns[c] == name) return c;
+    throw diefill::InputError(path.string(), "column " + name, "is missing", "Dump id x y z radius vx vy vz");
+  };
+  const std::size_t id = col("id"), x = col("x"), y = col("y"), z = col("z"), r = col("radius");
+  dem::State s;
+  while (std::getline(in, line)) {
+    std::istringstream row(line);
+    std::vector<double> v;
+    for (double d; row >> d;) v.push_back(d);
+    if (v.size() < columns.size()) continue;
+    s.add_sphere(std::int64_t(v[id]), dem::Vec3(v[x], v[y], v[z]), v[r], m.density, 0);
+  }
+  return s;
+}
+
+std::size_t bytes_of(const dem::State& s) {
+  auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  const auto& nl = s.neighbours;
+  const auto& pf = s.pair_forces;
+  return b(s.id) + b(s.x) + b(s.v) + b(s.w) + b(s.f) + b(s.torque) + b(s.radius) + b(s.mass) + b(s.inertia) +
+         b(s.material) + b(s.active) + b(s.wall_slots) + b(nl.row_start) + b(nl.partner) + b(nl.history) +
+         b(nl.reverse_start) + b(nl.reverse_pair) + b(nl.near_wall) + b(nl.x_at_build) + b(pf.force) + b(pf.torque);
+}
+
+json time_case(const std::string& name, const dem::Model& model, const dem::State& pack, int steps,
+               const std::vector<int>& thread_counts) {
+  json runs = json::array();
+  for (int threads : thread_counts) {
+    omp_set_num_threads(threads);
+    dem::State s = pack;
+    dem::initialize(model, s);
+    for (int n = 0; n < std::min(200, steps / 10); ++n) dem::step(model, s);  // warm-up
+    dem::StageTimes times;
+    diefill::Stopwatch clock;
+    const std::int64_t builds = s.neighbours.builds;
+    for (int n = 0; n < steps; ++n) dem::step(model, s, &times);
+    const double wall = clock.seconds();
+    const double rate = double(steps) * double(s.size()) / wall;
+    runs.push_back({{"threads", threads},
+                    {"steps", steps},
+                    {"wall_s", wall},
+                    {"particle_steps_per_s", rate},
+                    {"particle_steps_per_s_per_core", rate / threads},
+                    {"neighbour_builds", s.neighbours.builds - builds},
+                    {"contacts_per_grain", double(s.counters.contacts) * 2.0 / double(s.size())},
+                    {"listed_pairs_per_grain", double(s.neighbours.partner.size()) * 2.0 / double(s.size())},
+                    {"near_wall_grains", s.neighbours.near_wall.size()},
+                    {"wall_contacts", s.counters.wall_contacts},
+                    {"stages_s",
+                     {{"neighbours", times.neighbours},
+                      {"pair_forces", times.pair_forces},
+                      {"sums", times.sums},
+                      {"wall_forces", times.wall_forces},
+                      {"integration", times.integration},
+                      {"monitor", times.monitor}}}});
+    diefill::log::info("bench {}: {} threads, {:.3g} particle-steps/s", name, threads, rate);
+    if (threads == thread_counts.back())
+      runs.back()["bytes_per_particle"] = double(bytes_of(s)) / double(s.size());
+  }
+  return {{"case", name}, {"grains", pack.size()}, {"dt_s", model.dt}, {"runs", runs}};
+}
+
+// A settled dense pack of `count` equal spheres in the ring die, cached under `cache`.
+std::pair<dem::Model, dem::State> ring_pack(std::size_t count, const fs::path& cache) {
+  // Grain size such that the count fills the cavity about 1.5 times at a solid fraction 0.6.
+  const double cavity = 3.14159265358979 * (100e-6 - 25e-6) * 10e-3;
+  const double r = std::cbrt(0.6 * 1.5 * cavity / double(count) / (4.0 / 3.0 * 3.14159265358979)) / 1.0;
+  mesh::DieOptions options = mesh::die_options_for_grains(r, 0.5 * r);
+  options.table_margin_m = 4e-3;
+  const mesh::PreparedDie die = mesh::prepare_die(diefill::resource_path("dies/ring.stl"), options, cache);
+  dem::ModelSpec spec = reference_spec();
+  spec.time_step.reset();
+  spec.skin = 0.5 * r;
+  spec.gravity = dem::Vec3(0, 0, -9.81);
+  spec.domain = {dem::Vec3(-14e-3, -14e-3, -11e-3), dem::Vec3(14e-3, 14e-3, 30e-3)};
+  spec.meshes.push_back(dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid)), 0, "ring"));
+  const fs::path packed = cache / fmt::format("ring_pack_{}.csv", count);
+  dem::State s;
+  if (fs::exists(packed)) {
+    s = dem::read_particles_csv(packed, 0, 2500);
+  } else {
+    diefill::log::info("bench: preparing a settled pack of {} grains in the ring (once; cached in {})", count, packed.string());
+    dem::InsertRegion region;
+    region.box = {dem::Vec3(-9.9e-3, -9.9e-3, -9.9e-3), dem::Vec3(9.9e-3, 9.9e-3, 28e-3)};
+    region.accept = [](const dem::Vec3& p, double radius) {
+      const double rho = p.head<2>().norm();
+      return rho < 10e-3 - radius && rho > 5e-3 + radius;
+    };
+    dem::InsertRequest req;
+    req.count = count;
+    req.radius = r;
+    req.max_solid_fraction = 0.5;
+    dem::insert_spheres(s, region, req);
+    const dem::Model settle = dem::compile_model(spec, s, "bench");
+    dem::initialize(settle, s);
+    double fastest = 1;
+    while (fastest > 0.01 && s.time < 0.5) {
+      for (int n = 0; n < 2000; ++n) dem::step(settle, s);
+      fastest = 0;
+      for (const dem::Vec3& v : s.v) fastest = std::max(fastest, v.norm());
+    }
+    for (dem::Vec3& v : s.v) v.setZero();
+    for (dem::Vec3& w : s.w) w.setZero();
+    dem::write_particles_csv(s, packed);
+  }
+  dem::State fresh;
+  for (std::size_t i = 0; i < s.size(); ++i) fresh.add_sphere(s.id[i], s.x[i], s.radius[i], 2500, 0);
+  return {dem::compile_model(spec, fresh, "bench"), fresh};
+}
+
+}  // namespace
+
+int run_bench(const BenchCommand& c) {
+  std::vector<std::string> cases = c.cases;
+  if (cases.empty()) cases = {"ring-10k", "ring-100k"};
+  std::vector<int> thread_counts = c.threads;
+  if (thread_counts.empty()) thread_counts = {1, 2};
+  json results = {{"machine", {{"hardware_threads", std::thread::hardware_concurrency()}}}, {"cases", json::array()}};
+  for (const std::string& name : cases) {
+    if (name == "ring-10k" || name == "ring-100k") {
+      auto [model, pack] = ring_pack(name == "ring-10k" ? 10000 : 100000, c.cache);
+      results["cases"].push_back(time_case(name, model, pack, c.steps, thread_counts));
+    } else if (name == "liggghts") {
+      if (c.pack.empty() || c.stl.empty())
+        throw diefill::InputError("bench liggghts", "--pack/--stl", "the LIGGGHTS case needs the settled pack and the container",
+                                  "Run bench/compare_liggghts.sh, which prepares both");
+      dem::ModelSpec spec = reference_spec();
+      spec.gravity = dem::Vec3(0, 0, -9.81);
+      dem::State pack = read_lammps_dump(c.pack, spec.materials[0]);
+      mesh::DieOptions options = mesh::die_options_for_grains(0.5e-3, 0.25e-3);
+      options.role = mesh::WallRole::container;
+      const mesh::PreparedDie die = mesh::prepare_die(c.stl, options, c.cache);
+      const mesh::Box box = die.after.bbox;
+      spec.domain = {dem::Vec3(box.lo.x(), box.lo.y(), box.lo.z()) - dem::Vec3::Constant(1e-3),
+                     dem::Vec3(box.hi.x(), box.hi.y(), box.hi.z()) + dem::Vec3::Constant(1e-3)};
+      spec.meshes.push_back(dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid)), 0, "container"));
+      const dem::Model model = dem::compile_model(spec, pack, c.pack.string());
+      json r = time_case(name, model, pack, c.steps, thread_counts);
+      r["pack"] = c.pack.string();
+      r["container"] = c.stl.string();
+      r["container_triangles"] = die.after.triangles;
+      results["cases"].push_back(r);
+    } else if (name == "run-ring") {
+      app::PipelineScene scene = load_pipeline_scene(std::nullopt, {});
+      scene.out = c.cache / "run-ring";
+      fs::remove_all(scene.out);
+      diefill::Stopwatch clock;
+      const DieRun run = run_die_fill(scene, diefill::resource_path("dies/ring.stl"), false);
+      results["cases"].push_back({{"name", name},
+                                  {"threads", omp_get_max_threads()},
+                                  {"wall_s", clock.seconds()},
+                                  {"grains", run.report["particles"]["inserted"]},
+                                  {"fill_ratio", run.report["fill"]["fill_ratio"]},
+                                  {"timing", run.report["timing"]}});
+    } else {
+      throw diefill::InputError("bench", name, "is not a benchmark case", "Use ring-10k, ring-100k, liggghts or run-ring");
+    }
+  }
+  const std::string text = results.dump(2) + "\n";
+  if (c.json_out.empty()) fmt::print("{}", text);
+  else diefill::write_file_atomic(c.json_out, text);
+  return 0;
+}
+
+}  // namespace app

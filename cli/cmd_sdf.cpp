@@ -1,0 +1,65 @@
+// `diefill sdf`: the mesh stage on its own, with a readable mesh report and an optional
+// verification against the exact (Embree) distance.
+#include <fmt/core.h>
+
+#include "cli/commands.hpp"
+#include "core/error.hpp"
+#include "mesh/die.hpp"
+#include "mesh/verify.hpp"
+
+namespace app {
+
+int run_sdf(const SdfCommand& c) {
+  const double mm = 1e-3;
+  mesh::DieOptions options = mesh::die_options_for_grains(
+      c.grain_radius_mm * mm, c.skin_mm * mm,
+      c.voxel_mm ? std::optional<double>(*c.voxel_mm * mm) : std::nullopt);
+  options.unit = mesh::parse_unit(c.units, "--units");
+  options.role = mesh::parse_role(c.role, "--role");
+  if (c.tolerance_mm) options.repair.tolerance_m = *c.tolerance_mm * mm;
+  if (c.max_hole_mm) options.repair.max_hole_m = *c.max_hole_mm * mm;
+  options.table_margin_m = c.table_margin_mm * mm;
+
+  const mesh::PreparedDie die = mesh::prepare_die(c.mesh, options, std::nullopt);
+  fmt::print("mesh {} ({} units: {})\n", die.source, mesh::unit_name(options.unit), die.sha256);
+  fmt::print("check:\n{}", mesh::format_report(die.before));
+  if (die.actions.empty()) {
+    fmt::print("repair: nothing to do\n");
+  } else {
+    fmt::print("repair:\n");
+    for (const std::string& a : die.actions) fmt::print("  - {}\n", a);
+    fmt::print("  existing surface moved by at most {:.4g} mm (tolerance {:.4g} mm); new surface "
+               "spans gaps up to {:.4g} mm\n",
+               die.hausdorff_m / mm, options.repair.tolerance_m / mm, die.bridged_m / mm);
+    fmt::print("after repair:\n{}", mesh::format_report(die.after));
+  }
+  fmt::print("sdf: role {}, voxel {:.4g} mm, band {:.4g} mm outside / {:.4g} mm inside, "
+             "{} active voxels, {:.1f} MiB\n",
+             mesh::role_name(options.role), options.voxel_m / mm, options.exterior_band_m / mm,
+             options.interior_band_m / mm, die.sdf.active_voxels(),
+             double(die.sdf.memory_bytes()) / (1 << 20));
+  if (c.verify > 0) {
+    const mesh::ExactSurface exact(die.solid);
+    const mesh::WallField field = die.sdf.wall_field(die.solid);
+    const mesh::SdfVerification v = mesh::verify_sdf(field, die.solid, exact, c.verify, c.seed);
+    fmt::print("verify: {} points in the band (seed {}), {} farther than a voxel from a sharp "
+               "edge, {} with |exact| > 0.5 voxel\n",
+               v.samples, c.seed, v.smooth_samples, v.sign_checked);
+    auto show = [&](const char* what, const mesh::SdfErrors& e) {
+      fmt::print("  {}: |SDF - exact| max {:.3g} voxel, mean {:.3g} voxel; away from sharp edges "
+                 "max {:.3g} voxel at ({:.4f}, {:.4f}, {:.4f}) mm; sign disagreements {}\n",
+                 what, e.max_voxels, e.mean_voxels, e.max_smooth_voxels,
+                 e.worst_smooth_point.x() / mm, e.worst_smooth_point.y() / mm,
+                 e.worst_smooth_point.z() / mm, e.sign_disagreements);
+    };
+    show("wall query (what the simulation uses)", v.query);
+    show("grid, trilinear", v.grid);
+  }
+  if (!c.output.empty()) {
+    die.sdf.write(c.output);
+    fmt::print("wrote {}\n", c.output.string());
+  }
+  return 0;
+}
+
+}  // namespace app

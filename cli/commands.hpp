@@ -1,0 +1,98 @@
+#pragma once
+// The front end's commands, each a plain options struct and a function; main.cpp parses the
+// command line (CLI11 stays in that one file) and maps exceptions to exit statuses.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace app {
+
+std::string version_text();
+
+struct SdfCommand {
+  std::filesystem::path mesh;
+  std::filesystem::path output;
+  std::string units = "mm";
+  std::string role = "cavity";
+  std::optional<double> voxel_mm;
+  double grain_radius_mm = 0.5;
+  double skin_mm = 0.25;
+  std::optional<double> tolerance_mm;
+  std::optional<double> max_hole_mm;
+  double table_margin_mm = 10.0;
+  std::size_t verify = 0;
+  std::uint64_t seed = 1;
+};
+int run_sdf(const SdfCommand& command);
+
+struct RunCommand {
+  std::filesystem::path target;  // a die mesh, a folder of them, or a scene (.toml)
+  std::filesystem::path out;     // overrides output.directory
+  std::vector<std::string> overrides;
+  std::optional<int> threads;
+  std::optional<std::uint64_t> seed;
+  bool resume = false;
+};
+int run_pipeline(const RunCommand& command);
+
+struct SceneCommand {
+  std::filesystem::path target;
+  std::vector<std::string> overrides;
+};
+int run_scene(const SceneCommand& command);
+
+struct SimulateCommand {
+  std::filesystem::path scene;
+  std::filesystem::path out;  // overrides output.directory
+  std::vector<std::string> overrides;
+  std::optional<int> threads;
+  bool resume = false;
+};
+int run_simulate(const SimulateCommand& command);
+
+struct BenchCommand {
+  std::vector<std::string> cases;
+  std::filesystem::path json_out;
+  std::vector<int> threads;
+  int steps = 2000;
+  std::filesystem::path cache = "out/bench";
+  std::filesystem::path pack;  // liggghts: the settled pack (LAMMPS dump)
+  std::filesystem::path stl;   // liggghts: the container (mm)
+};
+int run_bench(const BenchCommand& command);
+
+struct DensityCommand {
+  std::filesystem::path particles;  // CSV or VTU
+  std::filesystem::path die;
+  std::filesystem::path output;
+  std::string units = "mm";
+  std::string role = "cavity";
+  double voxel_mm = 0;        // 0: four grain radii
+  std::string method = "exact";
+  double width_mm = 0;        // Gaussian width (0: one voxel)
+  double material_density = 0;  // 0: from the particle file
+  double coarse_graining = 1;    // α of the file's grains over the real powder's (1: they are the powder)
+};
+int run_density(const DensityCommand& command);
+
+struct DieCommand {
+  std::string name;  // bundled die
+  std::filesystem::path output;
+};
+int run_die(const DieCommand& command);
+
+struct ClumpCommand {
+  std::filesystem::path mesh;
+  std::string units = "mm";
+  double tolerance = 0.05;
+  int max_spheres = 64;
+  std::uint64_t seed = 1;
+  std::filesystem::path output = "out/clumps";
+};
+int run_clump(const ClumpCommand& command);
+
+// `diefill study`: studies/studies.hpp (study::StudyRequest, study::run_study).
+
+}  // namespace app

@@ -1,0 +1,171 @@
+// diefill's command line. Parsing only: each command lives in its own file (commands.hpp).
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include "cli/commands.hpp"
+#include "studies/studies.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+
+namespace {
+
+void add_sdf(CLI::App& root, app::SdfCommand& c, std::function<int()>& action) {
+  CLI::App* cmd = root.add_subcommand("sdf", "Check and repair a mesh, then write its signed-distance grid");
+  cmd->add_option("MESH", c.mesh, "Mesh file (STL, OBJ, PLY, OFF, ...)")->required();
+  cmd->add_option("-o,--output", c.output, "Output .vdb file");
+  cmd->add_option("--voxel", c.voxel_mm, "Voxel edge [mm] (default: a quarter of the grain radius)");
+  cmd->add_option("--units", c.units, "Length unit of the file: mm, m or in")->capture_default_str();
+  cmd->add_option("--role", c.role, "cavity (the part, open at the table), tool (the die body) or container (a closed vessel)")
+      ->capture_default_str();
+  cmd->add_option("--grain-radius", c.grain_radius_mm, "Largest grain radius [mm]")->capture_default_str();
+  cmd->add_option("--skin", c.skin_mm, "Neighbour skin [mm]")->capture_default_str();
+  cmd->add_option("--tolerance", c.tolerance_mm, "Largest change repair may make [mm] (default: half a voxel)");
+  cmd->add_option("--max-hole", c.max_hole_mm, "Largest hole repair fills [mm] (default: 10 voxels)");
+  cmd->add_option("--table-margin", c.table_margin_mm, "Die table beyond the cavity [mm]")->capture_default_str();
+  cmd->add_option("--verify", c.verify, "Compare N points in the band with the exact distance");
+  cmd->add_option("--seed", c.seed, "Seed of the verification points")->capture_default_str();
+  cmd->callback([&] { action = [&] { return app::run_sdf(c); }; });
+}
+
+void add_run(CLI::App& root, app::RunCommand& c, std::function<int()>& action) {
+  CLI::App* cmd = root.add_subcommand("run", "The whole pipeline on a die mesh, a folder of meshes, or a scene");
+  cmd->add_option("TARGET", c.target, "Die mesh, folder of meshes, or scene (.toml)")->required();
+  cmd->add_option("--out", c.out, "Output folder; each die writes into OUT/<die name>/ (default out)");
+  cmd->add_option("--set", c.overrides, "Override a scene key: --set motion.speed=0.2");
+  cmd->add_option("--threads", c.threads, "Threads (default: all cores); results do not depend on it");
+  cmd->add_option("--seed", c.seed, "Random seed of the powder");
+  cmd->add_flag("--resume", c.resume, "Continue an interrupted run from its checkpoint");
+  cmd->callback([&] { action = [&] { return app::run_pipeline(c); }; });
+}
+
+void add_scene(CLI::App& root, app::SceneCommand& c, std::function<int()>& action) {
+  CLI::App* cmd = root.add_subcommand("scene", "Print the fully resolved scene (every default, with its reason)");
+  cmd->add_option("TARGET", c.target, "Die mesh or scene (.toml)");
+  cmd->add_option("--set", c.overrides, "Override a scene key");
+  cmd->callback([&] { action = [&] { return app::run_scene(c); }; });
+}
+
+void add_simulate(CLI::App& root, app::SimulateCommand& c, std::function<int()>& action) {
+  CLI::App* cmd = root.add_subcommand("simulate", "Run a general DEM scene (explicit particles, walls, motions)");
+  cmd->add_option("SCENE", c.scene, "Scene file (TOML)")->required();
+  cmd->add_option("--out", c.out, "Output folder (overrides output.directory)");
+  cmd->add_option("--set", c.overrides, "Override a scene key: --set simulation.duration=0.01");
+  cmd->add_option("--threads", c.threads, "Threads (default: all cores)");
+  cmd->add_flag("--resume", c.resume, "Continue from the output folder's checkpoint");
+  cmd->callback([&] { action = [&] { return app::run_simulate(c); }; });
+}
+
+void add_bench(CLI::App& root, app::BenchCommand& c, std::function<int()>& action) {
+  CLI::App* cmd = root.add_subcommand("bench", "Performance cases; JSON results");
+  cmd->add_option("CASE", c.cases, "ring-10k, ring-100k (default both), liggghts, run-ring (the default pipeline on the ring, end to end)");
+  cmd->add_option("--json", c.json_out, "Write the results here instead of standard output");
+  cmd->add_option("--threads", c.threads, "Thread counts to time (default 1 2)");
+  cmd->add_option("--steps", c.steps, "Timed steps per run")->capture_default_str();
+  cmd->add_option("--cache", c.cache, "Folder for prepared packs and SDFs")->capture_default_str();
+  cmd->add_option("--pack", c.pack, "liggghts: settled pack (LAMMPS dump: id x y z radius vx vy vz)");
+  cmd->add_option("--stl", c.stl, "liggghts: container mesh (mm)");
+  cmd->callback([&] { action = [&] { return app::run_bench(c); }; });
+}
+
+void add_density(CLI::App& root, app::DensityCommand& c, std::function<int()>& action) {
+  CLI::App* cmd = root.add_subcommand("density", "Density field of a particle file on a die");
+  cmd->add_option("PARTICLES", c.particles, "Particles CSV or VTU snapshot")->required();
+  cmd->add_option("--die", c.die, "The die's cavity mesh")->required();
+  cmd->add_option("-o,--output", c.output, "Output folder")->required();
+  cmd->add_option("--units", c.units, "Length unit of the die mesh")->capture_default_str();
+  cmd->add_option("--role", c.role, "cavity or container")->capture_default_str();
+  cmd->add_option("--voxel", c.voxel_mm, "Voxel edge [mm] (default: four grain radii)");
+  cmd->add_option("--method", c.method, "exact (volume split exactly) or gaussian (kernel)")->capture_default_str();
+  cmd->add_option("--width", c.width_mm, "Gaussian width [mm] (default: one voxel)");
+  cmd->add_option("--material-density", c.material_density, "Grain material density [kg/m³] (default: from the file)");
+  cmd->add_option("--coarse-graining", c.coarse_graining,
+                  "The file's grains over the real powder's size, recorded in the field (1: they are the powder)")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 1e4));
+  cmd->callback([&] { action = [&] { return app::run_density(c); }; });
+}
+
+void add_die(CLI::App& root, app::DieCommand& c, std::function<int()>& action) {
+  CLI::App* cmd = root.add_subcommand("die", "Write a bundled die mesh (ring, disc) as binary STL in mm");
+  cmd->add_option("NAME", c.name, "ring or disc")->required();
+  cmd->add_option("-o,--output", c.output, "Output STL")->required();
+  cmd->callback([&] { action = [&] { return app::run_die(c); }; });
+}
+
+void add_clump(CLI::App& root, app::ClumpCommand& c, std::function<int()>& action) {
+  CLI::App* cmd = root.add_subcommand("clump", "Build the multi-sphere template of a grain shape, with its errors against the sphere count");
+  cmd->add_option("MESH", c.mesh, "Closed grain surface mesh")->required();
+  cmd->add_option("--units", c.units, "Length unit of the file: mm, m or in")->capture_default_str();
+  cmd->add_option("--tolerance", c.tolerance, "Largest volume and Hausdorff error, relative to the equivalent diameter")
+      ->capture_default_str();
+  cmd->add_option("--max-spheres", c.max_spheres, "Most spheres per grain")->capture_default_str();
+  cmd->add_option("--seed", c.seed, "Seed of the surface sampling")->capture_default_str();
+  cmd->add_option("-o,--output", c.output,
+                  "The template file (ending in .json, with NAME_errors.csv and .png beside it), or a folder for NAME.json, ...")
+      ->capture_default_str();
+  cmd->callback([&] { action = [&] { return app::run_clump(c); }; });
+}
+
+void add_study(CLI::App& root, app::study::StudyRequest& c, std::function<int()>& action) {
+  std::string names;
+  for (const std::string& name : app::study::study_names()) names += (names.empty() ? "" : ", ") + name;
+  CLI::App* cmd = root.add_subcommand("study", "Calibration and method studies; CSV, JSON and PNG charts in OUT/NAME/");
+  cmd->add_option("NAME", c.name, "Study: " + names)->required();
+  cmd->add_option("SCENE", c.scene, "Scene (.toml) whose powder and contact laws are studied (default: the pipeline's)");
+  cmd->add_option("--set", c.overrides, "Override a scene key: --set powder.coarse_graining=16");
+  cmd->add_option("--out", c.out, "Output folder")->capture_default_str();
+  cmd->add_flag("--reduced", c.reduced, "The small version the tests run (coarser, fewer points; minutes)");
+  cmd->add_option("--threads", c.threads, "Threads (default: all cores); results do not depend on it");
+  cmd->add_option("--seed", c.seed, "Random seed of the powder");
+  cmd->callback([&] { action = [&] { return app::study::run_study(c); }; });
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App root{"diefill: simulate how a powder fills a press die"};
+  root.set_version_flag("--version", [] { return app::version_text(); });
+  root.require_subcommand(1);
+  bool verbose = false;
+  root.add_flag("-v,--verbose", verbose, "Log each stage with its time");
+  root.parse_complete_callback([&] {
+    if (verbose) diefill::log::set_level(diefill::log::Level::verbose);
+  });
+  std::function<int()> action;
+  app::SdfCommand sdf;
+  app::DieCommand die;
+  app::RunCommand run;
+  add_run(root, run, action);
+  app::SceneCommand scene;
+  add_scene(root, scene, action);
+  app::SimulateCommand simulate;
+  add_simulate(root, simulate, action);
+  app::BenchCommand bench;
+  add_bench(root, bench, action);
+  app::DensityCommand density;
+  add_density(root, density, action);
+  add_sdf(root, sdf, action);
+  add_die(root, die, action);
+  app::ClumpCommand clump;
+  add_clump(root, clump, action);
+  app::study::StudyRequest study;
+  add_study(root, study, action);
+  try {
+    root.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int status = root.exit(e);
+    return status == 0 ? 0 : diefill::exit_bad_input;
+  }
+  try {
+    return action ? action() : diefill::exit_ok;
+  } catch (const diefill::InputError& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return diefill::exit_bad_input;
+  } catch (const diefill::StabilityError& e) {
+    fmt::print(stderr, "stopped: {}\n", e.what());
+    return diefill::exit_unstable;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return diefill::exit_other;
+  }
+}

@@ -1,0 +1,15 @@
+#include <fmt/core.h>
+
+#include "cli/commands.hpp"
+#include "mesh/versions.hpp"
+
+namespace app {
+
+std::string version_text() {
+  return fmt::format(
+      "diefill {}\n  CGAL {}\n  OpenVDB {}\n  assimp {}\n  Embree {}\n  Eigen {}", DIEFILL_VERSION,
+      mesh::cgal_version(), mesh::openvdb_version(), mesh::assimp_version(), mesh::embree_version(),
+      mesh::eigen_version());
+}
+
+}  // namespace app

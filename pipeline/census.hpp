@@ -1,0 +1,26 @@
+#pragma once
+// Counting every grain after the fill: in the cavity, in the shoe, elsewhere on the table, or lost
+// (spilled over the table's edge: counted; through the die: a leak, refused). A clump counts once,
+// by its centre of mass.
+#include <string>
+#include <vector>
+
+#include "dem/state.hpp"
+#include "pipeline/plan.hpp"
+#include "postprocess/field.hpp"
+
+namespace app {
+
+struct Census {
+  std::size_t grains = 0, in_cavity = 0, in_shoe = 0, elsewhere = 0, lost = 0, leaked = 0;
+  dem::Vec3 leak = dem::Vec3::Zero();   // one leaked grain's centre
+  std::vector<post::Grain> cavity;      // the cavity's grains as volumes for binning
+  double grain_volume_m3 = 0;           // of every grain (a clump's true volume, not its spheres')
+};
+
+Census count_grains(const dem::State& state, double table_z, const ShoePlan& shoe);
+// InputError naming the die when a grain left through it; a warning for grains spilled beside the
+// shoe (counted in the report, not in the fill).
+void check_losses(const Census& census, const std::string& die_source, const std::string& die_name);
+
+}  // namespace app

@@ -1,0 +1,64 @@
+#include "pipeline/die_fill.hpp"
+
+#include <omp.h>
+
+#include "core/timer.hpp"
+#include "pipeline/census.hpp"
+#include "pipeline/outputs.hpp"
+#include "pipeline/plan.hpp"
+#include "pipeline/shoe_fill.hpp"
+#include "pipeline/shoe_pass.hpp"
+#include "pipeline/walls.hpp"
+
+namespace app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The scene's thread count for the run's duration (0: leave it), restored afterwards so that a
+// process running several dies or studies keeps its own setting.
+class ThreadCount {
+ public:
+  explicit ThreadCount(int threads) : saved_(omp_get_max_threads()) {
+    if (threads > 0) omp_set_num_threads(threads);
+  }
+  ~ThreadCount() { omp_set_num_threads(saved_); }
+  ThreadCount(const ThreadCount&) = delete;
+  ThreadCount& operator=(const ThreadCount&) = delete;
+
+ private:
+  int saved_;
+};
+
+}  // namespace
+
+DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resume) {
+  diefill::Stopwatch clock;
+  const ThreadCount threads(s.threads);
+  const DieSource source = read_die(s, die_mesh);
+  ShoePlan shoe = plan_shoe(s, source);
+  const GrainSizing grains = size_grains(s, shoe, source.file.name);
+  set_clearance(s, grains, source.table_z, shoe);
+  const FillWalls walls = prepare_walls(s, source, grains, shoe);
+  DieRun run{walls.die.name, {}, s.out / walls.die.name, false};
+  fs::create_directories(run.dir);
+
+  const std::optional<SettledShoe> settled = fill_and_settle_shoe(s, walls, grains, shoe, source.table_z);
+  if (!settled) {
+    run.interrupted = true;
+    return run;
+  }
+  const std::optional<FillResult> fill = move_shoe(s, walls, shoe, source.table_z, settled->state, run.dir, resume);
+  if (!fill) {
+    run.interrupted = true;
+    return run;
+  }
+
+  const Census census = count_grains(fill->state, source.table_z, shoe);
+  check_losses(census, source.file.source, walls.die.name);
+  run.report = write_fill_outputs({s, walls, grains, shoe, *settled, *fill, census, source.table_z, clock.seconds()}, run.dir);
+  return run;
+}
+
+}  // namespace app

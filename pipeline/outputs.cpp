@@ -1,0 +1,97 @@
+#include "pipeline/outputs.hpp"
+
+#include <fmt/core.h>
+
+#include "core/atomic_file.hpp"
+#include "core/log.hpp"
+#include "dem/io.hpp"
+#include "dem/step.hpp"
+#include "pipeline/density_stage.hpp"
+
+namespace app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The density field of the cavity's grains (none: a warning and an empty fill).
+nlohmann::json write_density_field(const FillRecord& r, const fs::path& dir) {
+  if (r.census.cavity.empty()) {
+    diefill::log::warn("{}: no grain entered the cavity; no density field", r.walls.die.name);
+    return {{"mass_kg", 0.0}, {"fill_ratio", 0.0}};
+  }
+  DensitySettings ds;
+  ds.voxel_m = r.scene.density_voxel > 0 ? r.scene.density_voxel : 2 * r.grains.diameter;
+  ds.method = r.scene.density_method;
+  const double density = r.walls.spec.materials[std::size_t(r.walls.powder)].density;
+  DensityResult field = compute_density(r.census.cavity, r.walls.die, *r.walls.die_field, density, ds, r.walls.die.name);
+  field.field.metadata["coarse_graining"] = fmt::format("{}", r.grains.alpha);
+  field.field.metadata["die"] = r.walls.die.name;
+  write_density(field, dir);
+  return statistics_json(field.stats);
+}
+
+nlohmann::json report_json(const FillRecord& r, const nlohmann::json& fill) {
+  const PipelineScene& s = r.scene;
+  const mesh::PreparedDie& die = r.walls.die;
+  const bool clumps = !s.shape_mesh.empty();
+  const double steps = double(r.fill.loop.steps);
+  return {
+      {"die",
+       {{"name", die.name},
+        {"source", die.source},
+        {"sha256", die.sha256},
+        {"cavity_volume_m3", die.after.volume_m3},
+        {"triangles", die.before.triangles},
+        {"repaired", !die.actions.empty()},
+        {"repairs", die.actions},
+        {"table_z_m", r.table_z}}},
+      {"powder",
+       {{"grains", r.census.grains},
+        {"grains_requested", r.settled.requested},
+        {"grain_volume_m3", r.census.grain_volume_m3},
+        {"material_density", r.walls.spec.materials[std::size_t(r.walls.powder)].density},
+        {"coarse_graining", r.grains.alpha},
+        {"grain_diameter_m", r.grains.diameter},
+        {"shape", clumps ? s.shape_mesh : "sphere"},
+        {"spheres_per_grain", clumps ? r.fill.state.size() / std::max<std::size_t>(1, r.fill.state.bodies.size()) : std::size_t{1}}}},
+      {"shoe", {{"length_m", r.shoe.length}, {"width_m", r.shoe.width}, {"speed_m_s", s.speed}, {"passes", s.passes}}},
+      {"fill", fill},
+      {"particles",
+       {{"inserted", r.census.grains},
+        {"in_cavity", r.census.in_cavity},
+        {"in_shoe", r.census.in_shoe},
+        {"elsewhere", r.census.elsewhere},
+        {"lost", r.census.lost}}},
+      {"timing",
+       {{"wall_s", r.wall_s},
+        {"steps", r.fill.loop.steps},
+        {"dt_s", r.fill.dt},
+        {"particle_steps_per_s", steps * double(r.fill.state.size()) / std::max(1e-9, r.fill.loop.wall_s)},
+        {"stages", stage_times_json(r.fill.loop.times)}}},
+      {"final_state_sha256", dem::state_hash(r.fill.state)},
+      {"stability",
+       {{"max_overlap_rel", r.fill.loop.max_overlap_rel},
+        {"max_energy_gain", r.fill.loop.max_energy_gain},
+        {"checks_passed", true},
+        {"warnings", diefill::log::take_warnings()}}}};
+}
+
+}  // namespace
+
+nlohmann::json write_fill_outputs(const FillRecord& r, const fs::path& dir) {
+  diefill::StagingFolder out(dir);
+  const nlohmann::json fill = write_density_field(r, out.path());
+  dem::write_particles_csv(r.fill.state, out / "particles.csv");
+  dem::write_vtu(r.fill.state, out / "final.vtu");
+  diefill::write_file_atomic(out / "scene.toml", describe(r.scene));
+  const nlohmann::json report = report_json(r, fill);
+  diefill::write_file_atomic(out / "report.json", report.dump(2) + "\n");
+  out.commit();
+  diefill::log::info("{}: {} of {} grains in the cavity, fill ratio {:.3f}, mean solid fraction {:.3f} -> {}", r.walls.die.name,
+                     r.census.in_cavity, r.census.grains, fill.value("fill_ratio", 0.0), fill.value("solid_fraction_mean", 0.0),
+                     dir.string());
+  return report;
+}
+
+}  // namespace app

@@ -1,0 +1,89 @@
+#include "pipeline/plan.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+
+namespace app {
+
+using dem::Vec3;
+
+namespace {
+
+// Accelerate to v, cruise, decelerate to rest over `distance` (signed along x).
+void add_stroke(dem::Motion& m, double distance, double v, double a) {
+  const double sign = distance < 0 ? -1 : 1, d = std::abs(distance);
+  double ta = v / a, cruise = d - v * ta;
+  if (cruise < 0) ta = std::sqrt(d / a), cruise = 0;  // never reaches v
+  m.segments.push_back({ta, Vec3(sign * a, 0, 0)});
+  if (cruise > 0) m.segments.push_back({cruise / (a * ta), Vec3::Zero()});  // a ta = v
+  m.segments.push_back({ta, Vec3(-sign * a, 0, 0)});
+}
+
+// Solid fraction of a settled bed of these spheres (docs/PHYSICS.md §3: poured frictional spheres
+// 0.58-0.61): what the shoe's bed holds per volume.
+constexpr double bed_solid_fraction = 0.6;
+
+}  // namespace
+
+DieSource read_die(const PipelineScene& scene, const std::filesystem::path& die_mesh) {
+  if (mesh::parse_role(scene.die_role, "die.role") != mesh::WallRole::cavity)
+    throw diefill::InputError(die_mesh.string(), "die.role", "the pipeline fills a cavity", "Give the cavity mesh (role \"cavity\")");
+  DieSource die;
+  die.file = mesh::read_die_file(die_mesh, mesh::parse_unit(scene.die_units, "die.units"));
+  die.box = mesh::bounding_box(die.file.mesh);
+  die.table_z = die.box.hi.z();
+  return die;
+}
+
+ShoePlan plan_shoe(const PipelineScene& s, const DieSource& die) {
+  ShoePlan p;
+  p.length = s.shoe_length;
+  const double die_width = die.box.size().y();
+  p.width = s.trim_width ? std::min(s.shoe_width, die_width + 2 * s.side_margin) : s.shoe_width;
+  if (p.width < die_width + 2 * s.side_margin) {
+    diefill::log::warn("the shoe ({:.4g} mm wide) does not cover the die ({:.4g} mm) with its side margin; widened to {:.4g} mm",
+                       s.shoe_width * 1e3, die_width * 1e3, (die_width + 2 * s.side_margin) * 1e3);
+    p.width = die_width + 2 * s.side_margin;
+  }
+  p.y_centre = 0.5 * (die.box.lo.y() + die.box.hi.y());
+  p.x_start = die.box.lo.x() - s.start_gap - 0.5 * p.length;
+  p.x_end = die.box.hi.x() + s.end_gap + 0.5 * p.length;
+  p.motion.start_position = Vec3(p.x_start, p.y_centre, die.table_z);
+  for (int pass = 0; pass < s.passes; ++pass) {
+    add_stroke(p.motion, p.x_end - p.x_start, s.speed, s.acceleration);
+    if (s.dwell > 0) p.motion.segments.push_back({s.dwell, Vec3::Zero()});
+    if (s.return_stroke) add_stroke(p.motion, p.x_start - p.x_end, s.speed, s.acceleration);
+  }
+  for (const auto& seg : p.motion.segments) p.t_motion += seg.duration;
+  return p;
+}
+
+GrainSizing size_grains(const PipelineScene& s, const ShoePlan& shoe, const std::string& die_name) {
+  GrainSizing g;
+  g.diameter = s.grain_diameter();
+  const double bed = shoe.length * shoe.width * s.fill_height * bed_solid_fraction;
+  double estimate = bed / (std::numbers::pi / 6 * std::pow(g.diameter, 3));
+  if (estimate > double(s.max_grains)) {
+    const double scale = std::cbrt(estimate / double(s.max_grains));
+    diefill::log::warn("{}: {:.0f} grains of {:.3g} mm would exceed powder.max_grains = {}; using {:.3g} mm grains "
+                       "(coarse graining {:.3g} instead of {:.3g})",
+                       die_name, estimate, g.diameter * 1e3, s.max_grains, g.diameter * scale * 1e3, s.coarse_graining * scale,
+                       s.coarse_graining);
+    g.diameter *= scale;
+    estimate = double(s.max_grains);
+  }
+  g.count = std::size_t(estimate);
+  g.r_max = 0.5 * g.diameter * (1 + s.diameter_spread);
+  g.alpha = g.diameter / s.particle_diameter;
+  return g;
+}
+
+void set_clearance(const PipelineScene& s, const GrainSizing& grains, double table_z, ShoePlan& shoe) {
+  shoe.motion.start_position.z() = table_z + s.clearance * grains.r_max;
+}
+
+}  // namespace app

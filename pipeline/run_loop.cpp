@@ -1,0 +1,73 @@
+#include "pipeline/run_loop.hpp"
+
+#include <fmt/core.h>
+
+#include <atomic>
+#include <csignal>
+
+#include "core/error.hpp"
+#include "core/progress.hpp"
+#include "dem/checkpoint.hpp"
+
+namespace app {
+
+namespace {
+std::atomic<bool> g_interrupted{false};
+
+void on_interrupt(int) {
+  g_interrupted = true;
+  std::signal(SIGINT, SIG_DFL);
+}
+}  // namespace
+
+void install_interrupt_handler() { std::signal(SIGINT, on_interrupt); }
+
+LoopResult run_until(const dem::Model& model, dem::State& s, const LoopOptions& o) {
+  LoopResult result;
+  diefill::Stopwatch clock;
+  diefill::Progress progress(o.label, o.until);
+  const double start = s.time;
+  double next_output = o.output_every > 0 ? s.time : std::numeric_limits<double>::infinity();
+  const std::int64_t grains = std::int64_t(s.size());
+  while (s.time < o.until - 0.5 * model.dt) {
+    if (s.time >= next_output - 0.5 * model.dt && o.output) {
+      o.output(s);
+      next_output += o.output_every;
+      if (o.finished && o.finished(s)) {
+        result.finished_early = true;
+        break;
+      }
+    }
+    const dem::StepReport report = dem::step(model, s, &result.times);
+    ++result.steps;
+    result.max_overlap_rel = std::max(result.max_overlap_rel, s.counters.max_overlap_rel);
+    result.max_energy_gain = std::max(result.max_energy_gain, s.counters.energy_gain);
+    if (report.status != dem::StepStatus::ok) {
+      if (!o.checkpoint.empty()) dem::write_checkpoint(model, s, o.checkpoint);
+      throw diefill::StabilityError(report.message +
+                                    (o.checkpoint.empty() ? "" : fmt::format(" (checkpoint: {})", o.checkpoint.string())));
+    }
+    if (g_interrupted) {
+      if (!o.checkpoint.empty()) dem::write_checkpoint(model, s, o.checkpoint);
+      result.interrupted = true;
+      break;
+    }
+    if ((result.steps & 63) == 0) {
+      const double rate = double(result.steps) * double(grains) / std::max(1e-9, clock.seconds());
+      progress.update(s.time - start, fmt::format("t = {:.4g} s, {:.3g} particle-steps/s{}", s.time, rate,
+                                                  o.detail ? ", " + o.detail(s) : std::string()));
+    }
+  }
+  if (o.output && !result.interrupted && !result.finished_early) o.output(s);
+  result.wall_s = clock.seconds();
+  progress.finish(fmt::format("{} steps, {:.3g} particle-steps/s", result.steps,
+                              double(result.steps) * double(grains) / std::max(1e-9, result.wall_s)));
+  return result;
+}
+
+nlohmann::json stage_times_json(const dem::StageTimes& t) {
+  return {{"neighbours", t.neighbours}, {"pair_forces", t.pair_forces}, {"sums", t.sums},
+          {"wall_forces", t.wall_forces}, {"integration", t.integration}, {"monitor", t.monitor}};
+}
+
+}  // namespace app

@@ -1,0 +1,49 @@
+#pragma once
+// The stepping loop every command shares: outputs at their cadence, progress, a clean stop on
+// Ctrl-C with a checkpoint, and a failed stability check turned into a checkpoint plus
+// StabilityError (exit status 3).
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "dem/model.hpp"
+#include "dem/state.hpp"
+#include "dem/step.hpp"
+
+namespace app {
+
+struct LoopOptions {
+  double until = 0;  // simulated time to reach [s]
+  std::string label = "simulating";
+  std::filesystem::path checkpoint;  // written on a stop (stability or Ctrl-C)
+  double output_every = 0;           // [s]; 0: never
+  std::function<void(const dem::State&)> output;
+  // Asked after each output: true ends the loop there (a drained container).
+  std::function<bool(const dem::State&)> finished;
+  // Extra words for the progress line (grains in the cavity, ...).
+  std::function<std::string(const dem::State&)> detail;
+};
+
+struct LoopResult {
+  std::int64_t steps = 0;
+  double wall_s = 0;
+  dem::StageTimes times;
+  bool interrupted = false;  // Ctrl-C: a checkpoint was written
+  bool finished_early = false;  // options.finished said so
+  // Over the whole run, not its last step: the largest overlap over the grain radius, and the
+  // largest energy gain the monitor measured (dem::StepCounters::energy_gain), so that a run
+  // can be judged by what happened in it, not only by how it ended.
+  double max_overlap_rel = 0;
+  double max_energy_gain = 0;  // 0 when the energy never exceeded its budget
+};
+
+// Installs the Ctrl-C handler (once); a second Ctrl-C kills the process as usual.
+void install_interrupt_handler();
+
+LoopResult run_until(const dem::Model& model, dem::State& state, const LoopOptions& options);
+
+// Seconds per stage, as the reports write them.
+nlohmann::json stage_times_json(const dem::StageTimes& times);
+
+}  // namespace app

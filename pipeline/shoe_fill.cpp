@@ -1,0 +1,155 @@
+#include "pipeline/shoe_fill.hpp"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <filesystem>
+
+#include "core/log.hpp"
+#include "core/sha256.hpp"
+#include "dem/insert.hpp"
+#include "dem/io.hpp"
+#include "dem/step.hpp"
+#include "pipeline/clump_stage.hpp"
+#include "pipeline/run_loop.hpp"
+#include "scene/physics_keys.hpp"
+
+namespace app {
+
+namespace fs = std::filesystem;
+using dem::Vec3;
+
+namespace {
+
+// Random insertion jams near a third of the volume (random sequential adsorption), so a bed of
+// poured density 0.6 needs about twice its height of space; a round fills what space the shoe
+// has above the powder already in it, and the powder settles before the next.
+constexpr int max_insertion_rounds = 4;
+constexpr double insertion_solid_fraction = 0.45;  // stop a round's insertion at this fill of its box
+
+struct Insertion {
+  const PipelineScene& scene;
+  const FillWalls& walls;
+  const GrainSizing& grains;
+  const ShoePlan& shoe;
+  double table_z;
+  std::optional<mesh::ClumpTemplate> clump;
+};
+
+// The box above the powder already in the shoe (from the table at first), inside its walls.
+dem::InsertRegion space_above_bed(const Insertion& in, const dem::State& bed) {
+  const double inset = in.grains.r_max + 1e-6;
+  double floor = in.table_z;
+  for (std::size_t i = 0; i < bed.size(); ++i) floor = std::max(floor, bed.x[i].z() + bed.radius[i]);
+  const double first_round_top = in.table_z + in.scene.fill_height * 0.6 / 0.38 + 2 * in.grains.r_max;
+  const double top = in.table_z + in.scene.shoe_height - inset;
+  dem::InsertRegion region;
+  region.box = {Vec3(in.shoe.x_start - 0.5 * in.shoe.length + inset, in.shoe.y_centre - 0.5 * in.shoe.width + inset, floor + inset),
+                Vec3(in.shoe.x_start + 0.5 * in.shoe.length - inset, in.shoe.y_centre + 0.5 * in.shoe.width - inset,
+                     bed.size() == 0 ? std::min(top, first_round_top) : top)};
+  return region;
+}
+
+std::size_t insert_round(const Insertion& in, dem::State& bed, std::size_t count, int round) {
+  const dem::InsertRegion region = space_above_bed(in, bed);
+  if (region.box.hi.z() <= region.box.lo.z()) return 0;
+  const std::uint64_t seed = in.scene.seed + std::uint64_t(round) * 7919;  // round 0: the scene's seed, as always
+  const std::int64_t first_id = bed.size() == 0 ? 0 : *std::max_element(bed.id.begin(), bed.id.end()) + 1;
+  const double density = in.walls.spec.materials[std::size_t(in.walls.powder)].density;
+  if (in.clump)
+    return dem::insert_clumps(bed, region, *in.clump, in.grains.diameter / in.clump->equivalent_diameter_m, count,
+                              in.walls.powder, density, seed, first_id);
+  dem::InsertRequest request;
+  request.count = count;
+  request.radius = 0.5 * in.grains.diameter;
+  request.radius_spread = in.scene.diameter_spread;
+  request.material = in.walls.powder;
+  request.density = density;
+  request.seed = seed;
+  request.first_id = first_id;
+  request.max_solid_fraction = insertion_solid_fraction;
+  return dem::insert_spheres(bed, region, request);
+}
+
+// Settles the bed for shoe.settle_time at the scene's time step (the settling shoe sees no fall
+// into the die, so runs differing in the die's depth or the shoe's speed reuse it). False on Ctrl-C.
+bool settle(const Insertion& in, dem::State& bed, const std::string& label) {
+  dem::ModelSpec spec = in.walls.spec;
+  spec.max_impact_speed = in.scene.spec.max_impact_speed;
+  const dem::Model model = dem::compile_model(spec, bed, in.scene.source);
+  bed.time = 0;
+  bed.step = 0;
+  dem::initialize(model, bed);
+  LoopOptions loop;
+  loop.until = in.scene.shoe_settle_time;
+  loop.label = label;
+  return !run_until(model, bed, loop).interrupted;
+}
+
+std::optional<SettledShoe> settle_afresh(const Insertion& in, const std::string& die_name) {
+  SettledShoe out;
+  out.requested = in.grains.count;
+  for (int round = 0; round < max_insertion_rounds && out.inserted < out.requested; ++round) {
+    const std::size_t added = insert_round(in, out.state, out.requested - out.inserted, round);
+    if (added == 0) break;
+    out.inserted += added;
+    diefill::log::info("{}: settling {} {} of {:.3g} mm in the shoe ({:.3g} x {:.3g} mm{})", die_name, out.inserted,
+                       in.clump ? fmt::format("clumps of {} spheres", in.clump->spheres.size()) : "grains",
+                       in.grains.diameter * 1e3, in.shoe.length * 1e3, in.shoe.width * 1e3, in.clump ? "" : ", once; cached");
+    // Interrupted while settling: nothing is cached (a half-settled shoe must never be reused).
+    if (!settle(in, out.state, die_name + ": settling the shoe")) return std::nullopt;
+  }
+  if (out.inserted < out.requested)
+    diefill::log::warn("{}: the shoe holds {} of the {} grains that fill it to shoe.fill_height = {:.4g} mm; raise shoe.height or "
+                       "lower shoe.fill_height",
+                       die_name, out.inserted, out.requested, in.scene.fill_height * 1e3);
+  return out;
+}
+
+// A cached and a fresh run start from the same numbers: the file's, at rest.
+void rest(dem::State& state) {
+  for (Vec3& v : state.v) v.setZero();
+  for (Vec3& w : state.w) w.setZero();
+  for (Vec3& v : state.bodies.v) v.setZero();
+  for (Vec3& l : state.bodies.l) l.setZero();
+  state.time = 0;
+  state.step = 0;
+}
+
+}  // namespace
+
+std::string settled_shoe_key(const PipelineScene& s, const SettledShoeInputs& in, std::string_view dem_source_hash) {
+  return diefill::sha256_hex(fmt::format("settled shoe v3;{};{};{}{};{:a};{:a};{};{:a};{:a};{:a};{:a};{:a};{}", dem_source_hash,
+                                         in.die_cache_key, shaping_values(pipeline_keys(), Shapes::settling, s),
+                                         describe_materials(s.spec), in.grains.diameter, in.grains.r_max, in.grains.count,
+                                         in.shoe.length, in.shoe.width, in.shoe.x_start, in.shoe.y_centre, in.table_z, in.powder));
+}
+
+std::optional<SettledShoe> fill_and_settle_shoe(const PipelineScene& s, const FillWalls& walls, const GrainSizing& grains,
+                                                const ShoePlan& shoe, double table_z) {
+  Insertion in{s, walls, grains, shoe, table_z, std::nullopt};
+  // Clumps are settled afresh each run: the particles file does not hold their poses.
+  if (!s.shape_mesh.empty()) {
+    in.clump = build_clump({s.shape_mesh, mesh::parse_unit(s.shape_units, "powder.shape.units"), s.shape_tolerance, 64, s.seed});
+    std::optional<SettledShoe> settled = settle_afresh(in, walls.die.name);
+    if (settled) rest(settled->state);
+    return settled;
+  }
+  const std::string key = settled_shoe_key(s, {walls.die.cache_key, grains, shoe, table_z, walls.powder}, dem::source_hash());
+  const fs::path file = walls.cache / ("shoe-" + key + ".csv");
+  SettledShoe out;
+  out.from_cache = fs::exists(file);
+  if (!out.from_cache) {
+    const std::optional<SettledShoe> settled = settle_afresh(in, walls.die.name);
+    if (!settled) return std::nullopt;
+    fs::create_directories(walls.cache);
+    dem::write_particles_csv(settled->state, file);
+  }
+  out.state = dem::read_particles_csv(file, walls.powder, walls.spec.materials[std::size_t(walls.powder)].density);
+  out.requested = grains.count;
+  out.inserted = out.state.size();
+  rest(out.state);
+  return out;
+}
+
+}  // namespace app

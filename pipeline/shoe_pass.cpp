@@ -1,0 +1,50 @@
+#include "pipeline/shoe_pass.hpp"
+
+#include <fmt/core.h>
+
+#include "core/log.hpp"
+#include "dem/checkpoint.hpp"
+#include "dem/io.hpp"
+#include "dem/step.hpp"
+
+namespace app {
+
+namespace fs = std::filesystem;
+
+std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& walls, const ShoePlan& shoe, double table_z,
+                                    dem::State settled, const fs::path& dir, bool resume) {
+  dem::ModelSpec spec = walls.spec;
+  spec.meshes[1].motion = shoe.motion;
+  FillResult fill{std::move(settled), {}, 0};
+  dem::State& state = fill.state;
+  const dem::Model model = dem::compile_model(spec, state, s.source);
+  fill.dt = model.dt;
+  const fs::path checkpoint = dir / "checkpoint.bin";
+  if (resume && fs::exists(checkpoint)) {
+    state = dem::read_checkpoint(model, checkpoint);
+    diefill::log::info("{}: resumed at t = {:.6g} s", walls.die.name, state.time);
+  } else {
+    dem::initialize(model, state);
+  }
+  LoopOptions loop;
+  loop.until = shoe.t_motion + s.die_settle_time;
+  loop.label = walls.die.name + ": filling";
+  loop.checkpoint = checkpoint;
+  int snapshot = 0;
+  if (s.snapshot_every > 0) {
+    loop.output_every = s.snapshot_every;
+    loop.output = [&](const dem::State& st) { dem::write_vtu(st, dir / fmt::format("snapshot_{:05d}.vtu", snapshot++)); };
+  }
+  loop.detail = [&](const dem::State& st) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < st.size(); ++i) n += st.active[i] && st.body[i] < 0 && st.x[i].z() < table_z;
+    for (std::size_t b = 0; b < st.bodies.size(); ++b) n += st.bodies.active[b] && st.bodies.x[b].z() < table_z;
+    return fmt::format("{} grains in the cavity", n);
+  };
+  fill.loop = run_until(model, state, loop);
+  if (fill.loop.interrupted) return std::nullopt;
+  fs::remove(checkpoint);
+  return fill;
+}
+
+}  // namespace app

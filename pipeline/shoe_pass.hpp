@@ -1,0 +1,23 @@
+#pragma once
+// The shoe's pass over the die and the die's settling: one run of the stepping loop from the
+// settled shoe (or from the checkpoint an interrupted run left), with snapshots and progress.
+#include <filesystem>
+#include <optional>
+
+#include "dem/state.hpp"
+#include "pipeline/run_loop.hpp"
+#include "pipeline/walls.hpp"
+
+namespace app {
+
+struct FillResult {
+  dem::State state;
+  LoopResult loop;
+  double dt = 0;  // [s]
+};
+
+// nullopt when Ctrl-C stopped it (a checkpoint is in `dir`); StabilityError when a check did.
+std::optional<FillResult> move_shoe(const PipelineScene& scene, const FillWalls& walls, const ShoePlan& shoe, double table_z,
+                                    dem::State settled, const std::filesystem::path& dir, bool resume);
+
+}  // namespace app

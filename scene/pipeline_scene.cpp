@@ -1,0 +1,218 @@
+#include "scene/pipeline_scene.hpp"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+
+#include "core/error.hpp"
+#include "scene/physics_keys.hpp"
+#include "scene/toml_reader.hpp"
+
+namespace app {
+
+namespace {
+
+using P = PipelineScene;
+using K = SceneKey<P>;
+
+K number(std::string_view table, std::string_view name, std::string_view unit, ValueRange range, Shapes shapes,
+         std::string_view meaning, double P::*member) {
+  return {table, name, KeyType::number, unit, range, {}, shapes, meaning,
+          [member](const P& s) -> KeyValue { return s.*member; },
+          [member](P& s, const KeyValue& v) { s.*member = std::get<double>(v); }};
+}
+
+template <class Integer>
+K integer(std::string_view table, std::string_view name, ValueRange range, Shapes shapes, std::string_view meaning,
+          Integer P::*member) {
+  return {table, name, KeyType::integer, "", range, {}, shapes, meaning,
+          [member](const P& s) -> KeyValue { return double(s.*member); },
+          [member](P& s, const KeyValue& v) { s.*member = Integer(std::get<double>(v)); }};
+}
+
+K flag(std::string_view table, std::string_view name, Shapes shapes, std::string_view meaning, bool P::*member) {
+  return {table, name, KeyType::boolean, "", {}, {}, shapes, meaning,
+          [member](const P& s) -> KeyValue { return s.*member; },
+          [member](P& s, const KeyValue& v) { s.*member = std::get<bool>(v); }};
+}
+
+template <class Text>
+K text(std::string_view table, std::string_view name, KeyType type, std::vector<std::string_view> choices, Shapes shapes,
+       std::string_view meaning, Text P::*member) {
+  return {table, name, type, "", {}, std::move(choices), shapes, meaning,
+          [member](const P& s) -> KeyValue { return std::filesystem::path(s.*member).string(); },
+          [member](P& s, const KeyValue& v) { s.*member = Text(std::get<std::string>(v)); }};
+}
+
+dem::ModelSpec& spec_of(P& s) { return s.spec; }
+
+constexpr double metre_range_hi = 1.0;  // the die table is a desk, not a quarry
+
+KeyTable<P> make_pipeline_keys() {
+  const Shapes die = Shapes::die, settling = Shapes::settling, run = Shapes::run, nothing = Shapes::nothing;
+  KeyTable<P> k = {
+      text("die", "file", KeyType::path, {}, die, "the die's cavity mesh (relative to the scene file)", &P::die),
+      text("die", "units", KeyType::choice, {"mm", "m", "in"}, die, "the mesh file's length unit (files store none)",
+           &P::die_units),
+      text("die", "role", KeyType::choice, {"cavity"}, die,
+           "the mesh is the part's shape, open at the die table (its highest z); `diefill sdf --role` takes tools too",
+           &P::die_role),
+      number("die", "voxel_fraction", "largest grain radii", {0, 4, true}, die,
+             "SDF voxel edge: contacts are exact either way, finer voxels find them faster near curved walls",
+             &P::die_voxel_fraction),
+      number("shoe", "length", "m", {0, metre_range_hi, true}, settling, "inside, along the motion (x)", &P::shoe_length),
+      number("shoe", "width", "m", {0, metre_range_hi, true}, settling, "inside, across the motion (y)", &P::shoe_width),
+      number("shoe", "height", "m", {0, metre_range_hi, true}, settling, "inside", &P::shoe_height),
+      number("shoe", "wall_thickness", "m", {0, 0.1, true}, settling, "", &P::shoe_wall),
+      number("shoe", "fill_height", "m", {0, metre_range_hi, true}, settling,
+             "powder bed in the shoe: three times what the ring takes; outflow does not depend on the head (Beverloo)",
+             &P::fill_height),
+      number("shoe", "clearance", "largest grain radii", {0, 10}, settling,
+             "gap under the walls; the shoe strikes off at the table: lower pinches grains, higher lets them escape",
+             &P::clearance),
+      flag("shoe", "trim_width", settling, "simulate only the shoe's width over the die plus side_margin", &P::trim_width),
+      number("shoe", "side_margin", "m", {0, 0.1}, settling, "kept on each side of the die when trimming", &P::side_margin),
+      text("shoe", "mesh", KeyType::path, {}, settling, "a shoe mesh instead of the box (origin at its inner centre, on the table)",
+           &P::shoe_mesh),
+      number("motion", "speed", "m/s", {0, 10, true}, run, "cruise speed of the shoe over the die", &P::speed),
+      number("motion", "acceleration", "m/s²", {0, 1000, true}, run, "to and from the cruise speed", &P::acceleration),
+      number("motion", "start_gap", "m", {0, metre_range_hi}, settling,
+             "leading wall before the die's edge at the start (where the shoe settles)", &P::start_gap),
+      number("motion", "end_gap", "m", {0, metre_range_hi}, run, "trailing wall past the die's far edge at a pass's end",
+             &P::end_gap),
+      number("motion", "dwell", "s", {0, 100}, run, "at the far end before returning", &P::dwell),
+      integer("motion", "passes", {1, 100}, run, "passes over the die", &P::passes),
+      flag("motion", "return", run, "the shoe comes back after each pass", &P::return_stroke),
+      number("motion", "shoe_settle_time", "s", {0, 10}, settling, "the powder settles in the shoe before it moves (cached)",
+             &P::shoe_settle_time),
+      number("motion", "die_settle_time", "s", {0, 10}, run, "the die settles after the shoe has passed", &P::die_settle_time),
+      number("powder", "particle_diameter", "m", {1e-7, 0.1}, settling, "the real powder: a free-flowing atomised metal",
+             &P::particle_diameter),
+      number("powder", "coarse_graining", "", {1, 1e4}, settling,
+             "α: simulated grains α times the real ones; Hertz forces keep bulk behaviour (docs/PHYSICS.md §4)",
+             &P::coarse_graining),
+      number("powder", "diameter_spread", "", {0, 1, false, true}, settling,
+             "relative half-width of the uniform size distribution: ±10 % keeps the packing random", &P::diameter_spread),
+      integer("powder", "max_grains", {1, 1e9}, settling, "larger α, with a warning, when the shoe would need more",
+              &P::max_grains),
+      text("powder.shape", "mesh", KeyType::path, {}, settling,
+           "a grain shape: rigid multi-sphere clumps scaled to the grain diameter (volume-equivalent)", &P::shape_mesh),
+      number("powder.shape", "tolerance", "", {0, 0.5, true}, settling, "the clump's volume and Hausdorff error",
+             &P::shape_tolerance),
+      text("powder.shape", "units", KeyType::choice, {"mm", "m", "in"}, settling, "the grain mesh's length unit",
+           &P::shape_units),
+  };
+  add_physics_keys<P>(k, spec_of, settling);
+  const auto physics_end = std::stable_partition(k.begin(), k.end(), [](const K& key) { return key.table != "simulation"; });
+  KeyTable<P> simulation(physics_end, k.end());
+  k.erase(physics_end, k.end());
+  k.insert(k.end(), simulation.begin(), simulation.end());
+  k.push_back(integer("simulation", "seed", {0, 9007199254740992.0}, settling, "of the powder's random packing", &P::seed));
+  k.push_back(integer("simulation", "threads", {0, 4096}, nothing, "0: all cores; results do not depend on it", &P::threads));
+  k.push_back(number("density", "voxel", "m", {0, metre_range_hi}, run, "0: two grain diameters", &P::density_voxel));
+  k.push_back(text("density", "method", KeyType::choice, {"exact", "gaussian"}, run,
+                   "exact volume split, or Gaussian coarse graining", &P::density_method));
+  k.push_back(text("output", "directory", KeyType::text, {}, nothing, "each die writes into DIRECTORY/<die name>/ (relative "
+                   "to the working folder)", &P::out));
+  k.push_back(number("output", "snapshot_every", "s", {0, 100}, nothing, "VTU snapshots; 0: the final state only",
+                     &P::snapshot_every));
+  return k;
+}
+
+std::vector<dem::Material> default_materials() {
+  dem::Material powder;
+  powder.name = "powder";
+  powder.density = 7800;          // solid steel/iron
+  powder.youngs_modulus = 1e7;    // softened from 2e11 Pa: see describe()
+  powder.poisson_ratio = 0.3;
+  powder.restitution = 0.5;
+  powder.sliding_friction = 0.5;
+  powder.rolling_friction = 0.1;
+  dem::Material steel;
+  steel.name = "steel";
+  steel.density = 7800;
+  steel.youngs_modulus = 2.1e11;
+  steel.poisson_ratio = 0.3;
+  steel.restitution = 0.5;
+  steel.sliding_friction = 0.3;
+  steel.rolling_friction = 0.05;
+  return {powder, steel};
+}
+
+}  // namespace
+
+PipelineScene::PipelineScene() {
+  spec.materials = default_materials();
+  spec.rolling = dem::RollingLaw::epsd;
+  spec.max_impact_speed = 1.0;
+  spec.stop_overlap = 0.25;
+}
+
+const KeyTable<PipelineScene>& pipeline_keys() {
+  static const KeyTable<PipelineScene> keys = make_pipeline_keys();
+  return keys;
+}
+
+int material_named(const dem::ModelSpec& spec, const std::string& name) {
+  for (std::size_t m = 0; m < spec.materials.size(); ++m)
+    if (spec.materials[m].name == name) return int(m);
+  throw diefill::InputError("scene", "materials", "has no material named \"" + name + "\"", "Define it");
+}
+
+dem::ModelSpec coarse_grained_spec(const dem::ModelSpec& spec, double alpha) {
+  dem::ModelSpec scaled = spec;
+  scaled.linear_stiffness *= alpha;
+  return scaled;
+}
+
+PipelineScene load_pipeline_scene(const std::optional<std::filesystem::path>& scene_file,
+                                  const std::vector<std::string>& overrides) {
+  PipelineScene s;
+  TomlDocument doc = scene_file ? TomlDocument::parse(*scene_file) : TomlDocument::parse("(defaults)", std::string());
+  if (scene_file) s.source = scene_file->string();
+  doc.apply_overrides(overrides);
+  Table root = doc.root();
+  const std::filesystem::path base = scene_file ? scene_file->parent_path() : std::filesystem::path();
+  read_keys(root, pipeline_keys(), s, base);
+  const std::vector<std::string> names = read_materials(root, s.spec, base);
+  root.finish();
+
+  // What no single range can say.
+  if (s.fill_height > s.shoe_height) {
+    if (std::optional<Table> shoe = root.table("shoe")) shoe->fail("fill_height", "is higher than the shoe", "Lower it below shoe.height");
+    throw diefill::InputError(s.source, "shoe.fill_height", "is higher than the shoe", "Lower it below shoe.height");
+  }
+  for (const char* needed : {"powder", "steel"})
+    if (std::find(names.begin(), names.end(), needed) == names.end())
+      root.fail("materials", std::string("must define a material named \"") + needed + "\"",
+                "The powder is \"powder\"; the die and shoe are \"steel\"");
+  // Powder slides on the polished die table more easily than on itself, unless told otherwise.
+  if (s.spec.interactions.empty())
+    s.spec.interactions.push_back({int(std::find(names.begin(), names.end(), "powder") - names.begin()),
+                                   int(std::find(names.begin(), names.end(), "steel") - names.begin()), std::nullopt, 0.3,
+                                   0.05});
+  return s;
+}
+
+std::string describe(const PipelineScene& s) {
+  std::string out = fmt::format("# diefill scene, fully resolved ({}). SI units; the die mesh declares its own.\n", s.source);
+  std::vector<std::string_view> tables;
+  for (const auto& key : pipeline_keys())
+    if (std::find(tables.begin(), tables.end(), key.table) == tables.end()) tables.push_back(key.table);
+  for (std::string_view table : tables) {
+    const std::string body = describe_table(pipeline_keys(), table, s);
+    if (!body.empty()) out += "\n[" + std::string(table) + "]\n" + body;
+  }
+  return out + "\n" + describe_materials(s.spec);
+}
+
+std::string scene_keys_markdown() {
+  const PipelineScene defaults;
+  return markdown_table(pipeline_keys(), defaults) + "\nEach `[[materials]]` entry (defaults: \"powder\" and \"steel\", "
+         "printed by `diefill scene`):\n\n" + markdown_table(material_keys(), defaults.spec.materials.front(), "materials[].") +
+         "\nEach `[[interactions]]` entry names two materials (`materials = [\"a\", \"b\"]`) and replaces their mixing "
+         "rule (geometric means) for the values it gives:\n\n" +
+         markdown_table(interaction_keys(), InteractionEntry{}, "interactions[].");
+}
+
+}  // namespace app

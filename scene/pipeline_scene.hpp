@@ -1,0 +1,78 @@
+#pragma once
+// The die-filling scene of `diefill run` and `diefill scene`: embedded defaults that reproduce the
+// seed study's setup (J. Mech. Phys. Solids 57 (2009) 10-31): a box shoe 32 mm long (along the
+// motion), 50 mm wide and 37 mm high, open at the bottom, sliding on the die table over the
+// cavity, filled with a free-flowing metal powder represented by coarse-grained spheres. Every key
+// is in pipeline_keys(), with its unit, range and meaning (docs/INTERFACE.md, "Scene keys").
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dem/model.hpp"
+#include "scene/scene_keys.hpp"
+
+namespace app {
+
+struct PipelineScene {
+  std::string source = "(defaults)";  // the scene file, or the defaults
+  // [die]
+  std::filesystem::path die;  // mesh
+  std::string die_units = "mm";
+  std::string die_role = "cavity";
+  double die_voxel_fraction = 0.25;  // SDF voxel edge [largest grain radii] (mesh::default_voxel_fraction)
+  // [shoe] (metres)
+  double shoe_length = 32e-3, shoe_width = 50e-3, shoe_height = 37e-3, shoe_wall = 3e-3;
+  double fill_height = 8e-3;    // powder height in the shoe
+  double clearance = 1.0;       // gap between the shoe's walls and the die table [largest grain radii]
+  bool trim_width = true;       // simulate only the width over the die plus `side_margin`
+  double side_margin = 4e-3;
+  std::string shoe_mesh;        // optional: a mesh for the shoe instead of the box
+  // [motion]
+  double speed = 0.1, acceleration = 2.0, start_gap = 2e-3, end_gap = 2e-3, dwell = 0.0;
+  int passes = 1;
+  bool return_stroke = false;
+  double shoe_settle_time = 0.08, die_settle_time = 0.05;
+  // [powder]
+  double particle_diameter = 0.1e-3;  // real powder [m]
+  double coarse_graining = 8.0;       // α: simulated diameter = α × particle_diameter
+  double diameter_spread = 0.1;       // relative half-width of the uniform size distribution
+  std::size_t max_grains = 60000;     // coarser grains (larger α) beyond this, with a warning
+  std::string shape_mesh;             // clumps (issue 6): a grain surface mesh
+  double shape_tolerance = 0.05;
+  std::string shape_units = "mm";
+  // [materials], [contact], [simulation]
+  dem::ModelSpec spec;                // materials "powder", "steel"; laws; gravity; time step
+  std::uint64_t seed = 1;
+  int threads = 0;
+  // [density]
+  double density_voxel = 0;           // [m]; 0: two grain diameters
+  std::string density_method = "exact";
+  // [output]
+  std::filesystem::path out = "out";
+  double snapshot_every = 0;          // [s]; 0: final snapshot only
+
+  PipelineScene();  // the defaults: materials "powder" and "steel", EPSD rolling, ...
+  double grain_diameter() const { return coarse_graining * particle_diameter; }
+};
+
+// Every key of the pipeline's scene but the [[materials]] and [[interactions]] entries
+// (physics_keys.hpp), in the order `diefill scene` prints them.
+const KeyTable<PipelineScene>& pipeline_keys();
+
+// Defaults, then the scene file (when TARGET is a .toml) and `--set` overrides; unknown keys, wrong
+// types and values out of their range are errors naming the key, with file and line.
+PipelineScene load_pipeline_scene(const std::optional<std::filesystem::path>& scene_file,
+                                  const std::vector<std::string>& overrides);
+// Index of the material `name` ("powder", "steel"); InputError when the scene lacks it.
+int material_named(const dem::ModelSpec& spec, const std::string& name);
+// The contact laws for grains `alpha` times the real powder's size (docs/PHYSICS.md §4). Hertz,
+// damping to a restitution, rolling and SJKR cohesion scale by themselves; a linear spring must
+// stiffen as α, since contact.linear_stiffness is given for the real powder.
+dem::ModelSpec coarse_grained_spec(const dem::ModelSpec& spec, double alpha);
+// The fully resolved scene as TOML, every key with its value, unit and meaning.
+std::string describe(const PipelineScene& scene);
+// The Markdown reference of every key (docs/INTERFACE.md, "Scene keys", is generated from it).
+std::string scene_keys_markdown();
+
+}  // namespace app

@@ -1,0 +1,243 @@
+// `diefill study discharge`: the dynamic calibration of the seed study. (a) A container at rest
+// drains through a slot: flow rate against slot width, fitted to the Beverloo slot law. (b) The
+// pipeline's shoe crosses a die opening at speed v and delivers powder into a deep die (a bin):
+// delivered mass against v, against the moving-container law built from (a)'s constants and
+// against the critical-velocity law fitted to it (PHYSICS.md §3).
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "pipeline/die_fill.hpp"
+#include "studies/studies.hpp"
+#include "studies/study_scenes.hpp"
+#include "core/log.hpp"
+#include "mesh/import.hpp"
+#include "mesh/shapes.hpp"
+
+namespace app::study {
+
+namespace {
+
+using dem::Vec3;
+
+struct DischargeSizes {
+  std::vector<double> slot_widths;  // [grain diameters]
+  double container_width, fill_height, flow_time;
+  std::vector<double> speeds;       // [m/s]
+  double opening, bin_depth, shoe_fill;  // [shoe grain diameters]
+  double shoe_coarsening;           // the moving shoe's grains over the slot's
+};
+
+// Reduced, the slot keeps its full size and the scene's grains: five widths over a container ten
+// grains wide are what pins C_s and k (three widths of a container eight grains wide gave
+// C_s = 0.67 ± 0.12, k = 0.81 ± 0.51; the full layout at twice the grain size C_s = 0.92 ± 0.04,
+// below the slot law's published range), and it costs about two minutes on one core. The moving
+// shoe runs with grains twice as coarse, at six speeds: five above the critical one pin its
+// exponent (with three, n = 0.96 ± 0.25).
+DischargeSizes discharge_sizes(bool reduced) {
+  if (reduced) return {{5, 6.5, 8, 10, 12}, 10, 20, 0.3, {0.15, 0.25, 0.35, 0.5, 0.7, 0.9}, 10, 20, 12, 2};
+  return {{5, 6.5, 8, 10, 12}, 10, 20, 0.3, {0.1, 0.2, 0.35, 0.55, 0.8}, 10, 20, 12, 1};
+}
+
+// Beverloo slot law W = A (L - k d)(b - k d)^{3/2} with A = C_s rho_b sqrt(g).
+struct BeverlooFit {
+  double a = 0, k = 0, a_error = 0, k_error = 0;
+  double rms_relative_residual = 0;
+  double rate(double length, double width, double d) const { return a * beverloo_slot(length, width, k, d); }
+};
+
+BeverlooFit fit_beverloo(const std::vector<double>& width, const std::vector<double>& rate, double length, double d) {
+  const std::size_t n = width.size();
+  const auto shape = [&](double k, std::size_t i) { return beverloo_slot(length, width[i], k, d); };
+  const auto best_a = [&](double k) {
+    double fw = 0, ff = 0;
+    for (std::size_t i = 0; i < n; ++i) fw += shape(k, i) * rate[i], ff += shape(k, i) * shape(k, i);
+    return fw / ff;
+  };
+  const auto residual = [&](double k) {
+    const double a = best_a(k);
+    double ssr = 0;
+    for (std::size_t i = 0; i < n; ++i) ssr += std::pow(rate[i] - a * shape(k, i), 2);
+    return ssr;
+  };
+  // k on a fine grid (the residual is smooth and cheap); A follows linearly.
+  const double k_max = std::min(*std::min_element(width.begin(), width.end()), length) / d - 0.05;
+  BeverlooFit fit;
+  double best = std::numeric_limits<double>::infinity();
+  for (double k = 0; k <= k_max; k += 1e-3)
+    if (const double r = residual(k); r < best) best = r, fit.k = k;
+  fit.a = best_a(fit.k);
+  double rel = 0;
+  for (std::size_t i = 0; i < n; ++i) rel += std::pow(rate[i] / (fit.a * shape(fit.k, i)) - 1, 2);
+  fit.rms_relative_residual = std::sqrt(rel / double(n));
+  if (n > 2) {
+    // Standard errors from the linearised model: covariance sigma² (JᵀJ)⁻¹.
+    double jaa = 0, jak = 0, jkk = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double ja = shape(fit.k, i);
+      const double jk = fit.a * (-d * std::pow(width[i] - fit.k * d, 1.5) -
+                                 1.5 * d * (length - fit.k * d) * std::sqrt(width[i] - fit.k * d));
+      jaa += ja * ja, jak += ja * jk, jkk += jk * jk;
+    }
+    const double sigma2 = best / double(n - 2), det = jaa * jkk - jak * jak;
+    fit.a_error = std::sqrt(sigma2 * jkk / det);
+    fit.k_error = std::sqrt(sigma2 * jaa / det);
+  }
+  return fit;
+}
+
+// PHYSICS.md §3: a shoe of inner length Ls at speed v over an opening Ld x Bd.
+double moving_container_mass(const BeverlooFit& f, double d, double shoe_length, double opening_length,
+                             double opening_width, double v) {
+  const double l = std::min(shoe_length, opening_length) - f.k * d;
+  if (l <= 0) return 0;
+  return f.a * std::max(0.0, opening_width - f.k * d) / v *
+         (0.8 * std::pow(l, 2.5) + std::abs(shoe_length - opening_length) * std::pow(l, 1.5));
+}
+
+std::vector<double> sweep(double lo, double hi, int n) {
+  std::vector<double> x;
+  for (int i = 0; i < n; ++i) x.push_back(lo + (hi - lo) * i / (n - 1));
+  return x;
+}
+
+}  // namespace
+
+void discharge(const PipelineScene& scene, bool reduced, Output& out) {
+  const Powder powder = powder_of(scene);
+  const DischargeSizes z = discharge_sizes(reduced);
+  const double d = powder.diameter, g = powder.spec.gravity.norm();
+
+  // (a) Slot flow.
+  std::vector<double> widths, rates, errors, densities;
+  std::vector<std::vector<nlohmann::json>> rows;
+  Chart histories{"slot_discharge.png", "Discharged mass after the slot opens", "time [s]", "discharged mass [g]"};
+  for (double b_over_d : z.slot_widths) {
+    SlotContainer c;
+    c.slot_width = b_over_d * d;
+    c.length = (z.slot_widths.back() + 2 * 12) * d;
+    c.width = z.container_width * d;
+    c.fill_height = z.fill_height * d;
+    c.flow_time = z.flow_time;
+    const SlotRun run = run_slot_container(powder, c, fmt::format("discharge: slot {:.3g} mm", c.slot_width * 1e3));
+    const LineFit flow = steady_rate(run);
+    if (flow.points < 5)
+      diefill::log::warn("discharge: slot {:.3g} mm: only {} samples of steady flow", c.slot_width * 1e3, flow.points);
+    widths.push_back(c.slot_width);
+    rates.push_back(flow.slope);
+    errors.push_back(flow.slope_error);
+    densities.push_back(run.bulk_density);
+    rows.push_back({c.slot_width, flow.slope, flow.slope_error, run.bulk_density, run.initial_mass, flow.points});
+    Series h{fmt::format("b = {:.3g} mm", c.slot_width * 1e3), run.time, {}, {}, "line"};
+    for (double mass : run.discharged) h.y.push_back(mass * 1e3);
+    histories.series.push_back(h);
+  }
+  out.table("slot_flow.csv", {"slot_width_m", "rate_kg_s", "rate_error_kg_s", "bulk_density_kg_m3", "bed_mass_kg", "samples"},
+            rows);
+  double bulk_density = 0;
+  for (double rho : densities) bulk_density += rho / double(densities.size());
+  const double slot_length = z.container_width * d;
+  const BeverlooFit fit = fit_beverloo(widths, rates, slot_length, d);
+  const double scale = bulk_density * std::sqrt(g);
+  const double c_s = fit.a / scale, c_s_error = fit.a_error / scale;
+  diefill::log::info("discharge: Beverloo slot law C_s = {:.3f} ± {:.3f}, k = {:.2f} ± {:.2f} (bulk density {:.0f} kg/m³)", c_s,
+                     c_s_error, fit.k, fit.k_error, bulk_density);
+
+  Chart flow{"beverloo.png", "Slot discharge against the Beverloo slot law", "slot width b [mm]", "mass flow rate [g/s]"};
+  Series measured{"DEM", {}, {}, {}, "points"};
+  for (std::size_t i = 0; i < widths.size(); ++i)
+    measured.x.push_back(widths[i] * 1e3), measured.y.push_back(rates[i] * 1e3), measured.error.push_back(errors[i] * 1e3);
+  Series law_curve{fmt::format("Beverloo: C_s = {:.2f}, k = {:.2f}", c_s, fit.k), {}, {}, {}, "line"};
+  for (double b : sweep(fit.k * d, widths.back() * 1.1, 60))
+    law_curve.x.push_back(b * 1e3), law_curve.y.push_back(fit.rate(slot_length, b, d) * 1e3);
+  flow.series = {measured, law_curve};
+  out.chart(flow);
+  out.chart(histories);
+
+  // (b) The shoe over a deep die: delivered mass against speed.
+  const double shoe_d = z.shoe_coarsening * d;
+  const double opening = z.opening * shoe_d, depth = z.bin_depth * shoe_d;
+  const std::filesystem::path bin = out.work() / "bin.stl";
+  std::filesystem::create_directories(out.work());
+  mesh::write_stl(mesh::box_solid(Vec3(-0.5 * opening, -0.5 * opening, -depth), Vec3(0.5 * opening, 0.5 * opening, 0)), bin,
+                  mesh::LengthUnit::mm, "diefill discharge study: deep die");
+  const double capacity = bulk_density * opening * opening * depth;
+  // The law's mass, capped by what the die holds.
+  const auto law_mass = [&](double v) {
+    return std::min(capacity, moving_container_mass(fit, shoe_d, scene.shoe_length, opening, opening, v));
+  };
+  std::vector<double> law_error;
+  std::vector<double> speeds, delivered;
+  std::vector<std::vector<nlohmann::json>> shoe_rows;
+  for (double v : z.speeds) {
+    PipelineScene s = scene;
+    s.die_units = "mm";
+    s.speed = v;
+    s.acceleration = 10;  // about 1 g: the shoe reaches its speed before the opening
+    s.start_gap = v * v / (2 * s.acceleration) + 2e-3;
+    s.fill_height = z.shoe_fill * shoe_d;
+    s.coarse_graining = scene.coarse_graining * z.shoe_coarsening;
+    s.out = out.work() / fmt::format("shoe_{:.3f}_m_s", v);
+    const DieRun run = run_die_fill(s, bin, false);
+    const double mass = run.report["fill"].value("mass_kg", 0.0);
+    speeds.push_back(v);
+    delivered.push_back(mass);
+    law_error.push_back(mass / law_mass(v) - 1);
+    shoe_rows.push_back({v, mass, mass / capacity, law_mass(v)});
+  }
+  // Critical velocity: delta = (v_c / v)^n where the die is clearly not full.
+  std::vector<double> log_v, log_delta;
+  for (std::size_t i = 0; i < speeds.size(); ++i)
+    if (delivered[i] < 0.9 * capacity && delivered[i] > 0)
+      log_v.push_back(std::log(speeds[i])), log_delta.push_back(std::log(delivered[i] / capacity));
+  const LineFit power = fit_line(log_v, log_delta);
+  const double n = -power.slope, v_c = power.points >= 2 ? std::exp(power.intercept / n) : 0;
+  // Error propagation for ln v_c = intercept / n, the two errors taken as independent.
+  const double v_c_error = power.points > 2 ? v_c * std::hypot(power.intercept_error / n, power.intercept * power.slope_error / (n * n)) : 0;
+  bool falls = true;
+  for (std::size_t i = 1; i < speeds.size(); ++i)
+    if (speeds[i] > v_c && delivered[i] >= delivered[i - 1]) falls = false;
+  out.table("moving_shoe.csv", {"speed_m_s", "delivered_kg", "fill_ratio", "moving_container_law_kg"}, shoe_rows);
+
+  Chart mass_chart{"moving_shoe.png", "Mass a moving shoe delivers into a deep die", "shoe speed [m/s]", "delivered mass [g]"};
+  mass_chart.log_x = mass_chart.log_y = true;
+  Series dem_points{"DEM", speeds, {}, {}, "points"};
+  for (double m : delivered) dem_points.y.push_back(m * 1e3);
+  Series container_law{"moving-container law (from the slot fit)", {}, {}, {}, "line"};
+  Series critical{fmt::format("critical velocity: v_c = {:.3f} m/s, n = {:.2f}", v_c, n), {}, {}, {}, "line"};
+  for (double v : sweep(speeds.front() * 0.8, speeds.back() * 1.2, 60)) {
+    container_law.x.push_back(v);
+    container_law.y.push_back(law_mass(v) * 1e3);
+    critical.x.push_back(v);
+    critical.y.push_back(capacity * (v <= v_c ? 1.0 : std::pow(v_c / v, n)) * 1e3);
+  }
+  mass_chart.series = {dem_points, container_law, critical};
+  out.chart(mass_chart);
+
+  out.results = {
+      {"grain_diameter_m", d},
+      {"shoe_grain_diameter_m", shoe_d},
+      {"slot",
+       {{"length_m", slot_length},
+        {"widths_m", widths},
+        {"rates_kg_s", rates},
+        {"rate_errors_kg_s", errors},
+        {"bulk_density_kg_m3", bulk_density},
+        {"beverloo", {{"C_s", c_s}, {"C_s_error", c_s_error}, {"k", fit.k}, {"k_error", fit.k_error},
+                      {"rms_relative_residual", fit.rms_relative_residual}}}}},
+      {"moving_shoe",
+       {{"opening_m", {opening, opening}},
+        {"depth_m", depth},
+        {"capacity_kg", capacity},
+        {"shoe_length_m", scene.shoe_length},
+        {"speeds_m_s", speeds},
+        {"delivered_kg", delivered},
+        {"moving_container_law_relative_error", law_error},
+        {"critical_velocity", {{"v_c_m_s", v_c}, {"v_c_error_m_s", v_c_error}, {"n", n}, {"n_error", power.slope_error},
+                               {"points", power.points}}},
+        {"delivered_mass_falls_above_v_c", falls}}}};
+}
+
+}  // namespace app::study

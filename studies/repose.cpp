@@ -1,0 +1,122 @@
+// `diefill study repose`: the static calibration of the seed study. The heap angle (grains rained
+// onto a round pedestal) and the outflow angle (what stays in a container drained through a
+// slot), each from a straight-line fit of the free surface with its standard error, against
+// the grains' sliding and rolling friction, beside the correlation of Zhou et al. (2002).
+#include <fmt/core.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "studies/studies.hpp"
+#include "studies/study_scenes.hpp"
+#include "core/log.hpp"
+#include "dem/io.hpp"
+
+namespace app::study {
+
+namespace {
+
+struct Friction {
+  double sliding, rolling;
+};
+
+// PHYSICS.md §3, Zhou et al. 2002: degrees; d and the rolling arms (μ_r R*) in mm.
+double zhou_angle(double mu_pp, double mu_pw, double arm_pp_mm, double arm_pw_mm, double d_mm) {
+  return 68.61 * std::pow(mu_pp, 0.27) * std::pow(mu_pw, 0.22) * std::pow(arm_pp_mm, 0.06) * std::pow(arm_pw_mm, 0.12) *
+         std::pow(d_mm, -0.2);
+}
+
+}  // namespace
+
+void repose(const PipelineScene& scene, bool reduced, Output& out) {
+  const Powder base = powder_of(scene);
+  const double d = base.diameter;
+  const dem::Material& grain = base.spec.materials[std::size_t(base.powder)];
+  // Sliding friction swept at the scene's rolling friction, and rolling at its sliding.
+  const std::vector<double> sliding = reduced ? std::vector<double>{0.25} : std::vector<double>{0.2, 0.35, 0.5, 0.7, 0.9};
+  const std::vector<double> rolling = reduced ? std::vector<double>{0.0} : std::vector<double>{0.0, 0.05, 0.2, 0.4};
+  std::vector<Friction> cases;
+  for (double mu : sliding) cases.push_back({mu, grain.rolling_friction});
+  for (double mu_r : rolling) cases.push_back({grain.sliding_friction, mu_r});
+  if (reduced) cases.push_back({grain.sliding_friction, grain.rolling_friction});
+
+  Heap heap;
+  heap.pedestal_radius = (reduced ? 10 : 15) * d;
+  // Grains enough for a 45° cone over the pedestal and the dish's layer at a solid fraction of
+  // 0.6, so that the heap reaches its angle and sheds over the edge before the pour ends (with
+  // just a 35° cone's worth it stayed a flat-topped mound); poured in about a second.
+  const auto grains_in = [&](double bulk_volume) { return 0.6 * bulk_volume / grain_volume(d); };
+  const double area = std::numbers::pi * heap.pedestal_radius * heap.pedestal_radius;
+  heap.grains = std::size_t(grains_in(area * heap.pedestal_radius / 3 + area * d));
+  heap.pour_rate = double(heap.grains);
+  heap.drop_height = 2 * d;
+  heap.stream_radius = 3 * d;
+  const SlotContainer drain = outflow_container(d, reduced);
+
+  std::vector<std::vector<nlohmann::json>> rows;
+  nlohmann::json runs = nlohmann::json::array();
+  for (const Friction& f : cases) {
+    Powder p = base;
+    p.spec.materials[std::size_t(p.powder)].sliding_friction = f.sliding;
+    p.spec.materials[std::size_t(p.powder)].rolling_friction = f.rolling;
+    const std::string label = fmt::format("repose: μ = {:.2f}, μ_r = {:.2f}", f.sliding, f.rolling);
+    const HeapRun h = run_heap(p, heap, label + ", heap");
+    const SurfaceFit heap_fit = fit_heap_surface(h.state, heap, d);
+    const SlotRun o = run_slot_container(p, drain, label + ", outflow");
+    // The final beds, for a look in ParaView.
+    const std::string tag = fmt::format("mu{:.2f}_mur{:.2f}", f.sliding, f.rolling);
+    std::filesystem::create_directories(out.work());
+    dem::write_vtu(h.state, out.work() / ("heap_" + tag + ".vtu"));
+    dem::write_vtu(o.state, out.work() / ("outflow_" + tag + ".vtu"));
+    const OutflowAngle outflow_fit = outflow_angle(o.state, drain, d, 2 * d);
+    const double outflow = outflow_fit.angle_deg, outflow_error = outflow_fit.error_deg;
+    // The heap's base is coated with the powder (study_scenes.hpp): its friction is the grains'.
+    const double zhou = zhou_angle(f.sliding, f.sliding, f.rolling * 0.25 * d * 1e3, f.rolling * 0.5 * d * 1e3, d * 1e3);
+    diefill::log::info("{}: heap {:.1f}° ± {:.1f}°, outflow {:.1f}° ± {:.1f}°, Zhou {:.1f}°", label, heap_fit.angle_deg,
+                       heap_fit.angle_error_deg, outflow, outflow_error, zhou);
+    rows.push_back({f.sliding, f.rolling, heap_fit.angle_deg, heap_fit.angle_error_deg, outflow, outflow_error,
+                    std::isfinite(zhou) ? nlohmann::json(zhou) : nlohmann::json("")});
+    runs.push_back({{"sliding_friction", f.sliding},
+                    {"rolling_friction", f.rolling},
+                    {"heap_angle_deg", heap_fit.angle_deg},
+                    {"heap_angle_error_deg", heap_fit.angle_error_deg},
+                    {"heap_grains", h.on_pedestal},
+                    {"outflow_angle_deg", outflow},
+                    {"outflow_angle_error_deg", outflow_error},
+                    {"outflow_sides_deg", {outflow_fit.left_deg, outflow_fit.right_deg}},
+                    {"zhou_angle_deg", zhou}});
+  }
+  out.table("repose.csv",
+            {"sliding_friction", "rolling_friction", "heap_angle_deg", "heap_error_deg", "outflow_angle_deg", "outflow_error_deg",
+             "zhou_angle_deg"},
+            rows);
+
+  // One chart per swept friction, the other held at the scene's value.
+  const auto chart = [&](bool rolling_axis) {
+    Chart c{rolling_axis ? "repose_rolling.png" : "repose_sliding.png",
+            rolling_axis ? fmt::format("Angle of repose against rolling friction (μ = {:.2f})", grain.sliding_friction)
+                         : fmt::format("Angle of repose against sliding friction (μ_r = {:.2f})", grain.rolling_friction),
+            rolling_axis ? "rolling friction μ_r" : "sliding friction μ", "angle [°]"};
+    Series heap_series{"heap (DEM)", {}, {}, {}, "points"}, outflow_series{"outflow (DEM)", {}, {}, {}, "points"},
+        zhou_series{"Zhou et al. 2002", {}, {}, {}, "line"};
+    for (const auto& r : runs) {
+      const double held = rolling_axis ? r["sliding_friction"].get<double>() : r["rolling_friction"].get<double>();
+      if (held != (rolling_axis ? grain.sliding_friction : grain.rolling_friction)) continue;
+      const double x = rolling_axis ? r["rolling_friction"].get<double>() : r["sliding_friction"].get<double>();
+      heap_series.x.push_back(x), heap_series.y.push_back(r["heap_angle_deg"]), heap_series.error.push_back(r["heap_angle_error_deg"]);
+      outflow_series.x.push_back(x), outflow_series.y.push_back(r["outflow_angle_deg"]),
+          outflow_series.error.push_back(r["outflow_angle_error_deg"]);
+      if (const double z = r["zhou_angle_deg"].get<double>(); std::isfinite(z) && z > 0) zhou_series.x.push_back(x), zhou_series.y.push_back(z);
+    }
+    c.series = {heap_series, outflow_series, zhou_series};
+    out.chart(c);
+  };
+  chart(false);
+  chart(true);
+  out.results = {{"grain_diameter_m", d},
+                 {"heap", {{"pedestal_radius_m", heap.pedestal_radius}, {"grains_poured", heap.grains}}},
+                 {"outflow", {{"slot_width_m", drain.slot_width}, {"length_m", drain.length}, {"width_m", drain.width}}},
+                 {"runs", runs}};
+}
+
+}  // namespace app::study

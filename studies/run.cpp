@@ -1,0 +1,68 @@
+// `diefill study NAME [SCENE]`: the seed study's calibration experiments on the scene's powder,
+// each writing CSV tables, NAME.json and PNG charts into OUT/NAME/ (out/studies by default).
+// Here rather than in cli/ so that the tests run a study as the command does.
+#include <fmt/core.h>
+#include <omp.h>
+
+#include <functional>
+#include <map>
+
+#include "studies/studies.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/timer.hpp"
+
+namespace app::study {
+
+namespace {
+
+using StudyFunction = std::function<void(const PipelineScene&, bool, Output&)>;
+
+const std::map<std::string, StudyFunction>& studies() {
+  static const std::map<std::string, StudyFunction> table = {
+      {"discharge", discharge},
+      {"repose", repose},
+      {"stability", stability},
+      {"coarse-graining", coarse_graining},
+      {"speed-accuracy", speed_accuracy},
+      {"cross-validation", cross_validation}};
+  return table;
+}
+
+}  // namespace
+
+std::vector<std::string> study_names() {
+  std::vector<std::string> names;
+  for (const auto& [name, function] : studies()) names.push_back(name);
+  return names;
+}
+
+int run_study(const StudyRequest& c) {
+  const auto found = studies().find(c.name);
+  if (found == studies().end()) {
+    std::string known;
+    for (const std::string& name : study_names()) known += (known.empty() ? "" : ", ") + name;
+    throw diefill::InputError("", "NAME", fmt::format("there is no study \"{}\"", c.name), "Choose one of: " + known);
+  }
+  PipelineScene scene = load_pipeline_scene(c.scene, c.overrides);
+  if (c.threads) scene.threads = *c.threads;
+  if (c.seed) scene.seed = *c.seed;
+  if (scene.threads > 0) omp_set_num_threads(scene.threads);
+  diefill::Stopwatch clock;
+  Output out(c.out, c.name);
+  try {
+    found->second(scene, c.reduced, out);
+  } catch (const Interrupted&) {
+    fmt::print(stderr, "interrupted; {} keeps its earlier results\n", out.directory().string());
+    return diefill::exit_interrupted;
+  }
+  out.results["study"] = c.name;
+  out.results["reduced"] = c.reduced;
+  out.results["seed"] = scene.seed;
+  out.results["wall_s"] = clock.seconds();
+  out.commit();
+  diefill::log::info("study {}: {:.0f} s -> {}", c.name, clock.seconds(), out.directory().string());
+  return 0;
+}
+
+}  // namespace app::study

@@ -1,0 +1,246 @@
+#include "studies/study_scenes.hpp"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "core/error.hpp"
+#include "dem/step.hpp"
+#include "mesh/sdf.hpp"
+#include "mesh/shapes.hpp"
+#include "mesh/tool.hpp"
+
+namespace app::study {
+
+using dem::Vec3;
+
+double grain_volume(double diameter) { return std::numbers::pi / 6 * diameter * diameter * diameter; }
+
+namespace {
+
+dem::PlaneWall plane(const Vec3& point, const Vec3& normal, int material, const std::string& name) {
+  return {point, normal, material, name};
+}
+
+// Height below which a fraction `q` of the grains' centres lie.
+double centre_height_quantile(const dem::State& s, double q) {
+  std::vector<double> z;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (s.active[i]) z.push_back(s.x[i].z());
+  if (z.empty()) return 0;
+  const auto k = std::size_t(q * double(z.size() - 1));
+  std::nth_element(z.begin(), z.begin() + std::ptrdiff_t(k), z.end());
+  return z[k];
+}
+
+// Highest grain top per column (column index from `coordinate`), for the columns in [0, count).
+template <class Column>
+std::vector<double> column_tops(const dem::State& s, std::size_t count, Column column) {
+  std::vector<double> top(count, -std::numeric_limits<double>::infinity());
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (!s.active[i]) continue;
+    const long c = column(s.x[i]);
+    if (c >= 0 && std::size_t(c) < count) top[std::size_t(c)] = std::max(top[std::size_t(c)], s.x[i].z() + s.radius[i]);
+  }
+  return top;
+}
+
+SurfaceFit fit_surface(std::vector<double> position, std::vector<double> height) {
+  SurfaceFit fit;
+  for (std::size_t i = 0; i < position.size(); ++i)
+    if (std::isfinite(height[i])) fit.position.push_back(position[i]), fit.height.push_back(height[i]);
+  const LineFit line = fit_line(fit.position, fit.height);
+  fit.angle_deg = std::atan(std::abs(line.slope)) * 180 / std::numbers::pi;
+  // d(atan s)/ds = 1/(1+s²)
+  fit.angle_error_deg = line.slope_error / (1 + line.slope * line.slope) * 180 / std::numbers::pi;
+  return fit;
+}
+
+}  // namespace
+
+SlotContainer outflow_container(double d, bool reduced) {
+  SlotContainer c;
+  c.slot_width = 6 * d;
+  c.length = c.slot_width + 2 * (reduced ? 10 : 14) * d;
+  c.width = (reduced ? 6 : 8) * d;
+  c.fill_height = (reduced ? 12 : 16) * d;
+  c.flow_time = 1.5;
+  c.stop_when_drained = true;
+  return c;
+}
+
+SlotRun run_slot_container(const Powder& p, const SlotContainer& c, const std::string& label) {
+  const double r = p.r_max(), d = p.diameter;
+  const double half_l = 0.5 * c.length, half_w = 0.5 * c.width, floor = 2 * r;
+  if (c.slot_width >= c.length - 4 * d)
+    throw diefill::InputError(p.source, "slot_width", "leaves no floor beside the slot", "Use a narrower slot");
+  dem::ModelSpec spec = p.spec;
+  spec.planes = {plane(Vec3(0, -half_w, 0), Vec3::UnitY(), p.wall, "side -y"),
+                 plane(Vec3(0, half_w, 0), -Vec3::UnitY(), p.wall, "side +y"),
+                 plane(Vec3(-half_l, 0, 0), Vec3::UnitX(), p.wall, "end -x"),
+                 plane(Vec3(half_l, 0, 0), -Vec3::UnitX(), p.wall, "end +x")};
+  // The floor's plates reach past the side planes so that no grain finds a gap at the corners.
+  const double past = 2 * r;
+  spec.meshes = {block_wall(Vec3(-half_l - past, -half_w - past, -floor), Vec3(-0.5 * c.slot_width, half_w + past, 0), r,
+                            p.wall, "floor -x"),
+                 block_wall(Vec3(0.5 * c.slot_width, -half_w - past, -floor), Vec3(half_l + past, half_w + past, 0), r,
+                            p.wall, "floor +x")};
+  const double pour_height = c.fill_height * 0.6 / 0.42;  // poured loose, settles to about 0.6
+  spec.domain = {Vec3(-half_l - past, -half_w - past, -floor - 4 * d), Vec3(half_l + past, half_w + past, pour_height + 10 * d)};
+  spec.max_impact_speed = std::max(spec.max_impact_speed, std::sqrt(2 * spec.gravity.norm() * pour_height));
+
+  dem::ModelSpec gated = spec;
+  gated.planes.push_back(plane(Vec3::Zero(), Vec3::UnitZ(), p.wall, "gate"));
+  SlotRun run;
+  const auto wanted = std::size_t(c.length * c.width * c.fill_height * 0.6 / grain_volume(d));
+  dem::InsertRegion region;
+  region.box = {Vec3(-half_l + r, -half_w + r, r), Vec3(half_l - r, half_w - r, pour_height)};
+  add_grains(run.state, region, p, wanted, p.seed);
+  const dem::Model shut = dem::compile_model(gated, run.state, p.source);
+  dem::initialize(shut, run.state);
+  advance(shut, run.state, c.settle_time, label + ": settling");
+
+  // The bed: solid fraction of a slab well inside it, away from the walls and the surface.
+  run.bed_height = centre_height_quantile(run.state, 0.97);
+  const dem::Box3 core{Vec3(-half_l + 2 * d, -half_w + 2 * d, 2 * d), Vec3(half_l - 2 * d, half_w - 2 * d, run.bed_height - 2 * d)};
+  double solid = 0;
+  for (std::size_t i = 0; i < run.state.size(); ++i)
+    if (core.contains(run.state.x[i])) solid += grain_volume(2 * run.state.radius[i]);
+  const Vec3 core_size = core.hi - core.lo;
+  if (core_size.minCoeff() <= 0)
+    throw diefill::InputError(p.source, "fill_height", "leaves no bed to measure", "Give a container several grains deep");
+  run.bulk_density = p.density * solid / core_size.prod();
+  run.initial_mass = mass_where(run.state, [&](std::size_t i) { return run.state.active[i] != 0; });
+
+  // Open the gate.
+  forget_wall_contacts(run.state);
+  const dem::Model open = dem::compile_model(spec, run.state, p.source);
+  dem::initialize(open, run.state);
+  const double opened = run.state.time;
+  const auto gone = [&](std::size_t i) { return !run.state.active[i] || run.state.x[i].z() < -floor; };
+  double quiet_since = opened;
+  LoopOptions sampling;
+  sampling.output_every = c.sample_every;
+  sampling.output = [&](const dem::State& s) {
+    const double m = mass_where(s, gone);
+    if (run.discharged.empty() || m > run.discharged.back()) quiet_since = s.time;
+    run.time.push_back(s.time - opened);
+    run.discharged.push_back(m);
+  };
+  if (c.stop_when_drained) sampling.finished = [&](const dem::State& s) { return s.time - quiet_since > 0.1; };
+  advance(open, run.state, opened + c.flow_time, label, sampling);
+  return run;
+}
+
+double beverloo_slot(double length, double width, double k, double d) {
+  return std::max(0.0, length - k * d) * std::pow(std::max(0.0, width - k * d), 1.5);
+}
+
+LineFit steady_rate(const SlotRun& run) {
+  std::vector<double> t, m;
+  for (std::size_t i = 0; i < run.time.size(); ++i)
+    if (run.time[i] >= 0.05 && run.discharged[i] <= 0.4 * run.initial_mass) t.push_back(run.time[i]), m.push_back(run.discharged[i]);
+  return fit_line(t, m);
+}
+
+HeapRun run_heap(const Powder& p, const Heap& h, const std::string& label) {
+  const double r = p.r_max(), d = p.diameter, base = 4 * d;
+  dem::ModelSpec spec = p.spec;
+  // Heaps are measured on a base with a layer of grains fixed to it. On a flat plate, however
+  // frictional, the bottom layer rolls outward like ball bearings (rolling friction holds a
+  // slope of only atan mu_r) and the heap spreads to a few grains' thickness; here the
+  // pedestal's top is a dish one grain deep whose first grains, held by its rim, become that
+  // layer. The pedestal is powder against powder.
+  dem::Material base_material = spec.materials[std::size_t(p.powder)];
+  base_material.name = "heap base";
+  spec.materials.push_back(base_material);
+  const int rough = int(spec.materials.size()) - 1;
+  const mesh::TriMesh dish = mesh::ring_cavity(2 * h.pedestal_radius, 0, d, 0.01 * d);
+  mesh::TableExtent table = mesh::table_around(dish, 0.25 * d);
+  table.thickness = base;
+  const mesh::ToolMesh pedestal = mesh::tool_from_cavity(dish, table, "heap pedestal");
+  spec.meshes = {dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(mesh::contact_wall_field(pedestal.mesh, r)), rough, "pedestal")};
+
+  // Batches every 10 ms: a stream of the asked rate, each batch dropped just above the heap.
+  const double batch_period = 0.01;
+  const auto per_batch = std::max<std::size_t>(1, std::size_t(h.pour_rate * batch_period));
+  const double stream_area = std::numbers::pi * h.stream_radius * h.stream_radius;
+  const double batch_height = double(per_batch) * grain_volume(d) / (0.3 * stream_area) + 2 * d;
+  // The funnel's outlet follows the heap's apex (the highest grain at rest), as an operator
+  // raises it, so that grains land softly; the domain holds a heap up to 50°.
+  const double top = 1.2 * h.pedestal_radius + h.drop_height + batch_height + 2 * d;
+  const double reach = h.pedestal_radius + 10 * d;
+  spec.domain = {Vec3(-reach, -reach, -base - 2 * d), Vec3(reach, reach, top)};
+  spec.max_impact_speed = std::max(spec.max_impact_speed, std::sqrt(2 * spec.gravity.norm() * top));
+  HeapRun run;
+  std::optional<dem::Model> model;
+  std::size_t poured = 0;
+  for (int batch = 0; poured < h.grains; ++batch) {
+    double apex = 0;
+    for (std::size_t i = 0; i < run.state.size(); ++i)
+      if (run.state.active[i] && run.state.v[i].norm() < 0.05) apex = std::max(apex, run.state.x[i].z() + run.state.radius[i]);
+    const double floor_z = std::min(apex, 1.2 * h.pedestal_radius) + h.drop_height;
+    dem::InsertRegion region;
+    region.box = {Vec3(-h.stream_radius, -h.stream_radius, floor_z), Vec3(h.stream_radius, h.stream_radius, floor_z + batch_height)};
+    region.accept = [&](const Vec3& x, double radius) {
+      return std::hypot(x.x(), x.y()) + radius <= h.stream_radius;
+    };
+    const std::size_t added = add_grains(run.state, region, p, std::min(per_batch, h.grains - poured), p.seed + std::uint64_t(batch));
+    if (added == 0)
+      throw diefill::InputError(p.source, "heap.stream_radius", "no grain fits in the stream", "Widen the stream");
+    poured += added;
+    if (!model) model = dem::compile_model(spec, run.state, p.source);
+    dem::initialize(*model, run.state);  // neighbour lists for the new grains
+    advance(*model, run.state, run.state.time + batch_period, fmt::format("{}: pouring ({} of {})", label, poured, h.grains));
+  }
+  advance(*model, run.state, run.state.time + h.settle_time, label + ": settling");
+  for (std::size_t i = 0; i < run.state.size(); ++i) run.on_pedestal += run.state.active[i] && run.state.x[i].z() > -d;  // the dish's grains too
+  return run;
+}
+
+SurfaceFit fit_outflow_surface(const dem::State& s, const SlotContainer& c, double d, int side, double clear) {
+  const double from = 0.5 * c.slot_width + clear, to = 0.5 * c.length - clear;
+  const auto count = std::size_t(std::max(0.0, std::floor((to - from) / d)));
+  const std::vector<double> top = column_tops(s, count, [&](const Vec3& x) {
+    if (x.z() < 0 || x.x() * side <= 0) return -1L;
+    return long(std::floor((std::abs(x.x()) - from) / d));
+  });
+  std::vector<double> position(count);
+  for (std::size_t k = 0; k < count; ++k) position[k] = from + (double(k) + 0.5) * d;
+  return fit_surface(position, top);
+}
+
+OutflowAngle outflow_angle(const dem::State& s, const SlotContainer& c, double d, double clear) {
+  const SurfaceFit left = fit_outflow_surface(s, c, d, -1, clear), right = fit_outflow_surface(s, c, d, +1, clear);
+  return {0.5 * (left.angle_deg + right.angle_deg), 0.5 * std::hypot(left.angle_error_deg, right.angle_error_deg),
+          left.angle_deg, right.angle_deg};
+}
+
+SurfaceFit fit_heap_surface(const dem::State& s, const Heap& h, double d) {
+  // Rings one grain wide, each the mean of the highest tops in eight sectors (the maximum over a
+  // whole ring would rise with its area); the toe and the apex, flattened under the stream, left out.
+  constexpr int sectors = 8;
+  const double from = std::max(0.2 * h.pedestal_radius, h.stream_radius + d), to = 0.85 * h.pedestal_radius;
+  const auto rings = std::size_t(std::max(0.0, std::floor((to - from) / d)));
+  const std::vector<double> top = column_tops(s, rings * sectors, [&](const Vec3& x) {
+    const double radius = std::hypot(x.x(), x.y());
+    if (x.z() < 0 || radius < from || radius >= from + double(rings) * d) return -1L;
+    const double angle = std::atan2(x.y(), x.x()) + std::numbers::pi;
+    const long sector = std::min(sectors - 1L, long(angle / (2 * std::numbers::pi) * sectors));
+    return long(std::floor((radius - from) / d)) * sectors + sector;
+  });
+  std::vector<double> position, height;
+  for (std::size_t k = 0; k < rings; ++k) {
+    double sum = 0;
+    int found = 0;
+    for (int j = 0; j < sectors; ++j)
+      if (std::isfinite(top[k * sectors + std::size_t(j)])) sum += top[k * sectors + std::size_t(j)], ++found;
+    position.push_back(from + (double(k) + 0.5) * d);
+    height.push_back(found == sectors ? sum / sectors : std::numeric_limits<double>::quiet_NaN());
+  }
+  return fit_surface(position, height);
+}
+
+}  // namespace app::study

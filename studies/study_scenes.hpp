@@ -1,0 +1,80 @@
+#pragma once
+// The bench experiments the studies share.
+//  - Slot container: a box (x: length, y: width) whose floor has a slot across its whole width,
+//    closed by a gate while the poured powder settles, then opened: grains leave through the
+//    slot (counted as they drop below the floor) until the run ends or the flow stops. Gives the
+//    discharge rate (Beverloo slot law) and, once drained, the outflow angle of what remains.
+//  - Heap: grains rained onto a round pedestal from a narrow stream above its centre; those
+//    rolling over the edge fall away. Gives the heap angle of repose.
+#include <string>
+#include <vector>
+
+#include "studies/study_kit.hpp"
+
+namespace app::study {
+
+double grain_volume(double diameter);  // [m³] of a sphere
+
+struct SlotContainer {
+  double length = 0, width = 0, fill_height = 0;  // inner [m]; the slot runs along y, across the width
+  double slot_width = 0;                          // [m], centred at x = 0
+  double settle_time = 0.15;                      // [s] with the gate shut
+  double flow_time = 0.3;                         // [s] after opening, at most
+  double sample_every = 2.5e-3;                   // [s]
+  bool stop_when_drained = false;                 // end early once no grain has left for 0.1 s
+};
+
+// The container whose drained slopes give the outflow angle (and, while it drains, a flow rate):
+// a slot 6 grains wide, 10 (reduced) or 14 grains of floor beside it, run until no grain leaves.
+SlotContainer outflow_container(double diameter, bool reduced);
+
+struct SlotRun {
+  std::vector<double> time, discharged;  // since the opening [s]; mass below the floor or gone [kg]
+  double bulk_density = 0;               // of the settled bed [kg/m³]
+  double bed_height = 0;                 // [m]
+  double initial_mass = 0;               // [kg]
+  dem::State state;                      // at the end
+};
+
+SlotRun run_slot_container(const Powder& powder, const SlotContainer& container, const std::string& label);
+// The Beverloo slot law's geometry (L - k d)(b - k d)^{3/2} [m^{5/2}]: the rate over C_s rho_b sqrt(g).
+double beverloo_slot(double length, double width, double k, double d);
+// The steady discharge rate [kg/s]: a line through the discharged mass after the opening's
+// transient (50 ms) and before the bed has lost 40 % (its head then drops).
+LineFit steady_rate(const SlotRun& run);
+
+struct Heap {
+  double pedestal_radius = 0;  // [m]
+  double pour_rate = 0;        // grains per second
+  std::size_t grains = 0;      // poured in all
+  double drop_height = 0;      // of the stream's outlet above the heap's apex [m]
+  double stream_radius = 0;    // [m]
+  double settle_time = 0.15;   // after the last batch [s]
+};
+
+struct HeapRun {
+  dem::State state;
+  std::size_t on_pedestal = 0;
+};
+
+HeapRun run_heap(const Powder& powder, const Heap& heap, const std::string& label);
+
+// A free surface: the highest grain top per column, fitted with a straight line between `from`
+// and `to` along the column coordinate.
+struct SurfaceFit {
+  double angle_deg = 0, angle_error_deg = 0;
+  std::vector<double> position, height;  // the columns used [m]
+};
+// Columns one grain wide along |x| on one side of the slot (side = -1 or +1) in the drained
+// container, `clear` [m] kept clear of the slot's edge and of the end wall.
+SurfaceFit fit_outflow_surface(const dem::State& state, const SlotContainer& container, double diameter, int side,
+                               double clear);
+// The outflow angle: the mean of both sides' fits, with its standard error.
+struct OutflowAngle {
+  double angle_deg = 0, error_deg = 0, left_deg = 0, right_deg = 0;
+};
+OutflowAngle outflow_angle(const dem::State& state, const SlotContainer& container, double diameter, double clear);
+// Columns along the radius of the heap.
+SurfaceFit fit_heap_surface(const dem::State& state, const Heap& heap, double diameter);
+
+}  // namespace app::study
