@@ -56,6 +56,10 @@ std::vector<fs::path> meshes_in(const fs::path& folder) {
 }  // namespace
 
 int run_scene(const SceneCommand& c) {
+  if (c.keys) {
+    fmt::print("{}", scene_keys_markdown());
+    return 0;
+  }
   fmt::print("{}", describe(scene_for(c.target, c.overrides)));
   return 0;
 }

@@ -40,6 +40,7 @@ int run_pipeline(const RunCommand& command);
 struct SceneCommand {
   std::filesystem::path target;
   std::vector<std::string> overrides;
+  bool keys = false;  // the reference of every key (Markdown) instead of the resolved scene
 };
 int run_scene(const SceneCommand& command);
 

@@ -42,6 +42,7 @@ void add_scene(CLI::App& root, app::SceneCommand& c, std::function<int()>& actio
   CLI::App* cmd = root.add_subcommand("scene", "Print the fully resolved scene (every default, with its reason)");
   cmd->add_option("TARGET", c.target, "Die mesh or scene (.toml)");
   cmd->add_option("--set", c.overrides, "Override a scene key");
+  cmd->add_flag("--keys", c.keys, "Print every key with its type, unit, default, range and meaning (Markdown)");
   cmd->callback([&] { action = [&] { return app::run_scene(c); }; });
 }
 

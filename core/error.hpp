@@ -1,5 +1,5 @@
 #pragma once
-// Errors by phase (STYLE.md §8): configuration and input problems throw a typed exception that
+// Errors by phase (docs/INTERFACE.md, "Exit status"): configuration and input problems throw a typed exception that
 // names the file, the field and what to do; the front end maps the type to an exit status.
 #include <stdexcept>
 #include <string>

@@ -4,7 +4,7 @@
 // spring with history and a Coulomb cap), rolling (elastic-plastic spring or constant
 // directional torque) and cohesion (simplified JKR). Each slot is a small struct with its
 // parameters and a pure function; the force loop is instantiated once per combination in use
-// (forces.cpp), so adding a law never touches the loop. Equations: ../shared/docs/PHYSICS.md §2.
+// (forces.cpp), so adding a law never touches the loop. Equations: docs/PHYSICS.md §2.
 // The laws choose by selection, not by branches: the pair loop evaluates them over batches of
 // contacts that the compiler vectorises (one contact per lane, the same IEEE operations as one
 // at a time), which a branch would forbid.

@@ -1,5 +1,5 @@
 #pragma once
-// Particle files (INTERFACE.md): particles CSV in and out, trajectory CSV, VTU snapshots that
+// Particle files (docs/INTERFACE.md): particles CSV in and out, trajectory CSV, VTU snapshots that
 // ParaView reads. SI units throughout.
 #include <cstdio>
 #include <filesystem>

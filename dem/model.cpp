@@ -36,7 +36,7 @@ void check_material(const Material& m, std::size_t k, const std::string& source)
 
 double shear_modulus(const Material& m) { return m.youngs_modulus / (2 * (1 + m.poisson_ratio)); }
 
-// Rayleigh wave time of a grain (PHYSICS.md §5).
+// Rayleigh wave time of a grain (docs/PHYSICS.md §5).
 double rayleigh_time(const Material& m, double radius) {
   return std::numbers::pi * radius * std::sqrt(m.density / shear_modulus(m)) /
          (0.1631 * m.poisson_ratio + 0.8766);

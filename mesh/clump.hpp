@@ -1,5 +1,5 @@
 #pragma once
-// Multi-sphere clump templates of irregular grains (STYLE.md §4: clumps are templates plus
+// Multi-sphere clump templates of irregular grains (docs/ARCHITECTURE.md, "Grains": clumps are templates plus
 // instances). A template is built once per grain shape: the spheres, in the grain's principal
 // frame, plus the real grain's volume and principal moments, so that a simulation gives the
 // clump the mass and inertia of the grain rather than of the overlapping spheres.
@@ -38,7 +38,7 @@ struct ClumpOptions {
 // they got).
 ClumpTemplate make_clump(const TriMesh& grain, const ClumpOptions& options);
 
-// The template as JSON (INTERFACE.md, "Clump template").
+// The template as JSON (docs/INTERFACE.md, "Clump template").
 std::string clump_json(const ClumpTemplate& clump);
 
 }  // namespace mesh

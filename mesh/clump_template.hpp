@@ -1,5 +1,5 @@
 #pragma once
-// A multi-sphere clump template as plain data (STYLE.md §4: clumps are templates plus instances),
+// A multi-sphere clump template as plain data (docs/ARCHITECTURE.md, "Grains": templates plus instances),
 // in the small geometry target that the DEM links: the spheres in the grain's principal frame,
 // the real grain's volume and principal moments, and the approximation's errors. mesh/clump.hpp
 // builds one from a grain mesh.

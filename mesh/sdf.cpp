@@ -172,8 +172,8 @@ WallField SdfGrid::wall_field(const TriMesh& solid) const {
     for (openvdb::Index n = 0; n < 512; ++n) {
       const float v = leaf->getValue(n);
       w.distance.push_back(leaf->isValueOn(n) ? v : (v < 0 ? -solid_band : free_band));
-      const bool band = leaf->isValueOn(n) && index_leaf && index_leaf->isValueOn(n);
-      w.closest.push_back(band ? index_leaf->getValue(n) : -1);
+      const bool in_band = leaf->isValueOn(n) && index_leaf && index_leaf->isValueOn(n);
+      w.closest.push_back(in_band ? index_leaf->getValue(n) : -1);
     }
   }
   return w;

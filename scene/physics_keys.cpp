@@ -27,7 +27,7 @@ const KeyTable<dem::Material>& material_keys() {
       field<M>("materials", "density", KeyType::number, "kg/m³", {1, 1e5}, "of the solid grain material", &M::density),
       field<M>("materials", "youngs_modulus", KeyType::number, "Pa", {1e3, 1e13},
                "Hertz stiffness; softened powders keep overlaps near 1 % of the radius (checked each run)", &M::youngs_modulus),
-      field<M>("materials", "poisson_ratio", KeyType::number, "", {0, 0.5, false, true}, "", &M::poisson_ratio),
+      field<M>("materials", "poisson_ratio", KeyType::number, "", {0, 0.5, false, true}, "ν, with E the Hertz E* and G*", &M::poisson_ratio),
       field<M>("materials", "restitution", KeyType::number, "", {0, 1, true}, "of a head-on collision (damping calibrated to it)",
                &M::restitution),
       field<M>("materials", "sliding_friction", KeyType::number, "", {0, 10}, "Coulomb coefficient μ", &M::sliding_friction),

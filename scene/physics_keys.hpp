@@ -72,7 +72,7 @@ void add_physics_keys(KeyTable<Target>& keys, dem::ModelSpec& (*spec)(Target&), 
          "for the Hertz collision time; the pipeline raises it to sqrt(2 g depth) + shoe speed for deeper dies",
          [](const dem::ModelSpec& s) { return s.max_impact_speed; },
          [](dem::ModelSpec& s, const KeyValue& v) { s.max_impact_speed = std::get<double>(v); });
-  number("simulation", "gravity", KeyType::vec3, "m/s²", {-1000, 1000}, "",
+  number("simulation", "gravity", KeyType::vec3, "m/s²", {-1000, 1000}, "gravitational acceleration",
          [](const dem::ModelSpec& s) { return s.gravity; },
          [](dem::ModelSpec& s, const KeyValue& v) { s.gravity = std::get<dem::Vec3>(v); });
   number("simulation", "skin", KeyType::number_or_auto, "m", {0, 0.1, true},

@@ -63,7 +63,7 @@ KeyTable<P> make_pipeline_keys() {
       number("shoe", "length", "m", {0, metre_range_hi, true}, settling, "inside, along the motion (x)", &P::shoe_length),
       number("shoe", "width", "m", {0, metre_range_hi, true}, settling, "inside, across the motion (y)", &P::shoe_width),
       number("shoe", "height", "m", {0, metre_range_hi, true}, settling, "inside", &P::shoe_height),
-      number("shoe", "wall_thickness", "m", {0, 0.1, true}, settling, "", &P::shoe_wall),
+      number("shoe", "wall_thickness", "m", {0, 0.1, true}, settling, "of the box shoe's walls", &P::shoe_wall),
       number("shoe", "fill_height", "m", {0, metre_range_hi, true}, settling,
              "powder bed in the shoe: three times what the ring takes; outflow does not depend on the head (Beverloo)",
              &P::fill_height),
@@ -107,7 +107,7 @@ KeyTable<P> make_pipeline_keys() {
   KeyTable<P> simulation(physics_end, k.end());
   k.erase(physics_end, k.end());
   k.insert(k.end(), simulation.begin(), simulation.end());
-  k.push_back(integer("simulation", "seed", {0, 9007199254740992.0}, settling, "of the powder's random packing", &P::seed));
+  k.push_back(integer("simulation", "seed", {0, 9007199254740991.0}, settling, "of the powder's random packing", &P::seed));
   k.push_back(integer("simulation", "threads", {0, 4096}, nothing, "0: all cores; results do not depend on it", &P::threads));
   k.push_back(number("density", "voxel", "m", {0, metre_range_hi}, run, "0: two grain diameters", &P::density_voxel));
   k.push_back(text("density", "method", KeyType::choice, {"exact", "gaussian"}, run,
@@ -201,18 +201,19 @@ std::string describe(const PipelineScene& s) {
     if (std::find(tables.begin(), tables.end(), key.table) == tables.end()) tables.push_back(key.table);
   for (std::string_view table : tables) {
     const std::string body = describe_table(pipeline_keys(), table, s);
-    if (!body.empty()) out += "\n[" + std::string(table) + "]\n" + body;
+    if (!body.empty()) out += fmt::format("\n[{}]\n{}", table, body);
   }
   return out + "\n" + describe_materials(s.spec);
 }
 
 std::string scene_keys_markdown() {
   const PipelineScene defaults;
-  return markdown_table(pipeline_keys(), defaults) + "\nEach `[[materials]]` entry (defaults: \"powder\" and \"steel\", "
-         "printed by `diefill scene`):\n\n" + markdown_table(material_keys(), defaults.spec.materials.front(), "materials[].") +
-         "\nEach `[[interactions]]` entry names two materials (`materials = [\"a\", \"b\"]`) and replaces their mixing "
-         "rule (geometric means) for the values it gives:\n\n" +
-         markdown_table(interaction_keys(), InteractionEntry{}, "interactions[].");
+  return fmt::format(
+      "{}\nEach `[[materials]]` entry (defaults: \"powder\" and \"steel\", printed by `diefill scene`):\n\n{}\n"
+      "Each `[[interactions]]` entry names two materials (`materials = [\"a\", \"b\"]`) and replaces their mixing rule "
+      "(geometric means) for the values it gives:\n\n{}",
+      markdown_table(pipeline_keys(), defaults), markdown_table(material_keys(), defaults.spec.materials.front(), "materials[]."),
+      markdown_table(interaction_keys(), InteractionEntry{}, "interactions[]."));
 }
 
 }  // namespace app

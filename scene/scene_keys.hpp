@@ -142,7 +142,9 @@ std::string describe_table(const KeyTable<Target>& keys, std::string_view table,
     if (key.type == KeyType::path && std::get<std::string>(value).empty()) continue;
     std::string line = std::string(key.name) + " = " + toml_value(value, key.type);
     line.resize(std::max<std::size_t>(line.size() + 1, 32), ' ');
-    out += line + "# " + (key.unit.empty() ? std::string() : "[" + std::string(key.unit) + "] ") + std::string(key.meaning) + "\n";
+    std::string comment = (key.unit.empty() ? std::string() : "[" + std::string(key.unit) + "] ") + std::string(key.meaning);
+    while (!comment.empty() && comment.back() == ' ') comment.pop_back();
+    out += line + "# " + comment + "\n";
   }
   return out;
 }

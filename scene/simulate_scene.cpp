@@ -45,7 +45,7 @@ KeyTable<S> make_simulation_keys() {
       value_key<S>("simulation", "duration", KeyType::number, "s", {0, 1e4, true}, "simulated time", &S::duration),
   };
   add_physics_keys<S>(k, spec_of, Shapes::settling);
-  k.push_back(value_key<S>("simulation", "seed", KeyType::integer, "", {0, 9007199254740992.0}, "", &S::seed));
+  k.push_back(value_key<S>("simulation", "seed", KeyType::integer, "", {0, 9007199254740991.0}, "", &S::seed));
   k.push_back(value_key<S>("simulation", "threads", KeyType::integer, "", {0, 4096}, "0: all cores", &S::threads));
   k.back().shapes = Shapes::nothing;
   return k;

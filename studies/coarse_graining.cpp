@@ -1,5 +1,5 @@
 // `diefill study coarse-graining`: does a result change when the grains are coarsened with the
-// force laws scaled (PHYSICS.md §4)? Three factors α spanning 4x in grain size (2x reduced),
+// force laws scaled (docs/PHYSICS.md §4)? Three factors α spanning 4x in grain size (2x reduced),
 // each running the same fixed-size experiments: a slot container discharged and drained (flow
 // rate, outflow angle) and the bundled ring die filled by the pipeline (fill density). The
 // boundary corrections are applied and reported: the Beverloo k·αd term for the flow, and for
@@ -25,7 +25,7 @@ namespace {
 
 using dem::Vec3;
 
-// k of the Beverloo correction: the middle of the published range for spheres (PHYSICS.md §3).
+// k of the Beverloo correction: the middle of the published range for spheres (docs/PHYSICS.md §3).
 constexpr double beverloo_k = 1.5;
 
 // Targets of the seed study's invariance claim.
@@ -62,10 +62,10 @@ struct CoarseGrainingSizes {
 };
 
 CoarseGrainingSizes coarse_graining_sizes(bool reduced) {
-  // Reduced: √2 steps about the scene's grains. With 2x coarser grains (1.6 mm, five across the
-  // slot) the outflow angle fell 1.8-3° below the finer ones' at either size: a boundary effect of
-  // the coarsest grains, not the invariance under test.
-  if (reduced) return {{std::sqrt(0.5), 1, std::sqrt(2.0)}, 5, 10, 5, 8};
+  // Reduced: the default's container (it holds the coarsest grains six across the slot; five gave
+  // them an outflow angle 2.5-3.2° below the finer ones', a boundary effect, not the invariance
+  // under test) without its finest, most costly grains.
+  if (reduced) return {{1, std::sqrt(2.0), 2}, 6, 10, 5, 8};
   return {{0.5, 1, 2}, 6, 10, 5, 8};
 }
 
@@ -130,8 +130,8 @@ void coarse_graining(const PipelineScene& scene_in, bool reduced, Output& out) {
   const double ring_area = std::numbers::pi * (ring_outer_radius * ring_outer_radius - ring_inner_radius * ring_inner_radius);
   const double ring_volume = ring_area * ring_depth;
   const double ring_surface = 2 * ring_area + 2 * std::numbers::pi * (ring_outer_radius + ring_inner_radius) * ring_depth;
-  // Reduced, the ring is not filled: 0.57-1.13 mm grains are 4 to 9 across its annulus, far from
-  // the 20 that PHYSICS.md §4 asks for, so their fill tests no invariance (the pipeline tests
+  // Reduced, the ring is not filled: 0.8-1.6 mm grains are 3 to 6 across its annulus, far from
+  // the 20 that docs/PHYSICS.md §4 asks for, so their fill tests no invariance (the pipeline tests
   // fill it); the slot container scales with the grains and is the whole reduced study.
   const bool fill_ring = !reduced;
 

@@ -2,7 +2,7 @@
 // drains through a slot: flow rate against slot width, fitted to the Beverloo slot law. (b) The
 // pipeline's shoe crosses a die opening at speed v and delivers powder into a deep die (a bin):
 // delivered mass against v, against the moving-container law built from (a)'s constants and
-// against the critical-velocity law fitted to it (PHYSICS.md §3).
+// against the critical-velocity law fitted to it (docs/PHYSICS.md §3).
 #include <fmt/core.h>
 
 #include <algorithm>
@@ -88,7 +88,7 @@ BeverlooFit fit_beverloo(const std::vector<double>& width, const std::vector<dou
   return fit;
 }
 
-// PHYSICS.md §3: a shoe of inner length Ls at speed v over an opening Ld x Bd.
+// docs/PHYSICS.md §3: a shoe of inner length Ls at speed v over an opening Ld x Bd.
 double moving_container_mass(const BeverlooFit& f, double d, double shoe_length, double opening_length,
                              double opening_width, double v) {
   const double l = std::min(shoe_length, opening_length) - f.k * d;

@@ -20,7 +20,7 @@ struct Friction {
   double sliding, rolling;
 };
 
-// PHYSICS.md §3, Zhou et al. 2002: degrees; d and the rolling arms (μ_r R*) in mm.
+// docs/PHYSICS.md §3, Zhou et al. 2002: degrees; d and the rolling arms (μ_r R*) in mm.
 double zhou_angle(double mu_pp, double mu_pw, double arm_pp_mm, double arm_pw_mm, double d_mm) {
   return 68.61 * std::pow(mu_pp, 0.27) * std::pow(mu_pw, 0.22) * std::pow(arm_pp_mm, 0.06) * std::pow(arm_pw_mm, 0.12) *
          std::pow(d_mm, -0.2);

@@ -22,7 +22,7 @@ inline dem::Material glass(double e = 0.5, double mu = 0.0) {
   return m;
 }
 
-// A wall material so stiff that E* is the grain's E/(1-ν²) to 1e-12 (PHYSICS.md §2).
+// A wall material so stiff that E* is the grain's E/(1-ν²) to 1e-12 (docs/PHYSICS.md §2).
 inline dem::Material rigid_wall(double e = 0.5, double mu = 0.0) {
   dem::Material m = glass(e, mu);
   m.name = "rigid";

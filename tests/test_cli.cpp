@@ -162,7 +162,7 @@ TEST(CliDensity, WritesAFieldThatOpenVdbReadsBack) {
   write_disc_particles(dir / "grains.csv");
   const std::string out = (dir / "field").string();
   const test::Run run = test::run_diefill("density " + (dir / "grains.csv").string() + " --die " +
-                                          (test::source_dir() / "dies" / "disc.stl").string() + " --voxel 1 -o " + out);
+                                          (test::source_dir() / "dies" / "disc.stl").string() + " --voxel 1 --coarse-graining 8 -o " + out);
   ASSERT_EQ(run.status, 0) << run.output;
   for (const char* file : {"density.vdb", "density.vti", "density.json", "top_view.png", "section.png", "histogram.png"})
     EXPECT_TRUE(std::filesystem::exists(dir / "field" / file)) << file;
@@ -184,7 +184,7 @@ for item in cav.citerOnValues():
     worst = max(worst, abs(acc_rho.getValue(ijk) - 7800 * acc_phi.getValue(ijk)))
 report = json.load(open(sys.argv[1] + "/density.json"))
 print(json.dumps({"names": names, "voxel": phi.transform.voxelSize()[0], "units": phi["units"],
-                  "sha": phi["die_sha256"], "grains": phi["grains"], "material_density": phi["material_density"],
+                  "coarse_graining": phi["coarse_graining"], "die": phi["die"], "sha": phi["die_sha256"], "grains": phi["grains"], "material_density": phi["material_density"],
                   "mean": num / den, "report_mean": report["fill"]["solid_fraction_mean"], "density_error": worst,
                   "origin": list(phi.transform.indexToWorld((0, 0, 0)))}))
 )");
@@ -198,6 +198,8 @@ print(json.dumps({"names": names, "voxel": phi.transform.voxelSize()[0], "units"
   EXPECT_EQ(j["names"], nlohmann::json({"cavity_fraction", "density", "solid_fraction"}));
   EXPECT_DOUBLE_EQ(j["voxel"].get<double>(), 1e-3);
   EXPECT_EQ(j["units"], "m");
+  EXPECT_EQ(j["coarse_graining"], "8");  // as the pipeline's field records it
+  EXPECT_EQ(j["die"], "disc");
   EXPECT_EQ(j["sha"].get<std::string>().size(), 64u);
   EXPECT_DOUBLE_EQ(j["material_density"].get<double>(), 7800);
   EXPECT_NEAR(j["mean"].get<double>(), j["report_mean"].get<double>(), 1e-6);
@@ -223,4 +225,33 @@ TEST(CliDensity, BadInputLeavesNoPartialOutput) {
   expect_refused("id,x,y,z,vx,vy,vz,wx,wy,wz\n1,0,0,-0.005,0,0,0,0,0,0\n", "column radius", die);
   expect_refused("id,x,y,z,vx,vy,vz,wx,wy,wz,radius\n1,nan,0,-0.005,0,0,0,0,0,0,5e-4\n", "not a finite number", die);
   expect_refused("id,x,y,z,vx,vy,vz,wx,wy,wz,radius,density\n1,0.5,0.5,0.5,0,0,0,0,0,0,1e-3,7800\n", "lies in the cavity", die);
+}
+
+// `diefill sdf -o FILE.vdb` writes the distance grid alone: OpenVDB's own Python module refused
+// the whole file while it also held the Int32 grid of closest triangles (kept in the cache).
+TEST(CliSdf, OutputOpensInOpenVdbsPythonModule) {
+  test::TempDir dir;
+  const std::string out = (dir / "ring.vdb").string();
+  const test::Run run = test::run_diefill("sdf " + (test::source_dir() / "dies" / "ring.stl").string() + " --voxel 0.5 -o " + out);
+  ASSERT_EQ(run.status, 0) << run.output;
+  const test::Run py = test::run_command(
+      "/usr/bin/python3 -c 'import sys, pyopenvdb as v; g, m = v.readAll(sys.argv[1]); print(\" \".join(x.name for x in g), "
+      "g[0][\"units\"])' " + out + " 2>&1");
+  EXPECT_EQ(py.status, 0) << py.output;
+  EXPECT_EQ(py.output, "sdf m\n");
+}
+
+// `diefill clump MESH -o grain.json` writes that file (the interface promises it), with the
+// errors beside it; it wrote a folder named grain.json.
+TEST(CliClump, OutputEndingInJsonIsTheTemplateFile) {
+  test::TempDir dir;
+  // An octahedron-like grain: a box is the simplest closed grain mesh at hand; a loose tolerance.
+  test::write_text(dir / "grain.stl", test::ascii_stl(test::box_mm(0, 2)));
+  const test::Run run = test::run_diefill("clump " + (dir / "grain.stl").string() + " --tolerance 0.25 -o " +
+                                          (dir / "out" / "grain.json").string());
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir / "out" / "grain.json"));
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir / "out" / "grain_errors.csv"));
+  const auto clump = nlohmann::json::parse(test::read_text(dir / "out" / "grain.json"));
+  EXPECT_GE(clump["spheres"].size(), 1u);
 }

@@ -1,4 +1,4 @@
-// Contact laws against PHYSICS.md §6: Hertz impact, restitution, oblique impact, rolling.
+// Contact laws against docs/PHYSICS.md §6: Hertz impact, restitution, oblique impact, rolling.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -72,7 +72,7 @@ TEST(Hertz, ImpactMatchesTheoryForPairAndWall) {
   const double r = 1e-3, v = 0.5, E = 1e8, nu = 0.25;
   const double m = 2500 * 4.0 / 3.0 * std::numbers::pi * r * r * r;
   for (bool wall : {false, true}) {
-    // PHYSICS.md §6: pair: E* = E/(2(1-ν²)), R* = r/2, m* = m/2; rigid wall: E* = E/(1-ν²), R* = r, m* = m.
+    // docs/PHYSICS.md §6: pair: E* = E/(2(1-ν²)), R* = r/2, m* = m/2; rigid wall: E* = E/(1-ν²), R* = r, m* = m.
     const double e_star = wall ? E / (1 - nu * nu) : E / (2 * (1 - nu * nu));
     const double r_eff = wall ? r : r / 2, m_eff = wall ? m : m / 2;
     const double peak = std::pow(15 * m_eff * v * v / (16 * e_star * std::sqrt(r_eff)), 0.4);
@@ -112,7 +112,7 @@ TEST(Restitution, IsIndependentOfImpactSpeed) {
 }
 
 TEST(Friction, ObliqueImpactInGrossSlidingFollowsCoulomb) {
-  // PHYSICS.md §6: gross sliding throughout when tan θ > 3.5 μ(1+e); then the tangential
+  // docs/PHYSICS.md §6: gross sliding throughout when tan θ > 3.5 μ(1+e); then the tangential
   // restitution of the centre velocity is 1 − μ(1+e)/tan θ.
   const double r = 1e-3, e = 0.5, mu = 0.1, vn = 0.3;
   for (double tan_theta : {0.6, 1.0, 3.0}) {
@@ -152,7 +152,7 @@ TEST(Friction, SlidingSphereEndsRollingAtFiveSevenths) {
 
 // ---- the laws no impact test reaches: rolling resistance, cohesion, sticking friction --------
 // One glass sphere (r = 1 mm, E = 1e8 Pa, ν = 0.25) on a rigid floor, each law against its
-// closed form (PHYSICS.md §2).
+// closed form (docs/PHYSICS.md §2).
 
 namespace {
 

@@ -217,3 +217,49 @@ TEST(Insertion, FillsAClosedMeshWithoutOverlapsReproducibly) {
   EXPECT_EQ(a.x, b.x);
   EXPECT_NE(a.x, c.x);
 }
+
+namespace {
+
+// A paddle (a 10 x 2 x 2 mm bar) spinning about the z axis through its middle, beside a grain at
+// rest: only its rotation moves it.
+dem::ModelSpec paddle_spec(double spin, double skin) {
+  dem::ModelSpec spec = test::spec_with({test::glass(), test::rigid_wall()});
+  dem::MeshWall paddle =
+      dem::fixed_mesh_wall(test::wall_field_of(mesh::box_solid(Vec3(-5e-3, -1e-3, -1e-3), Vec3(5e-3, 1e-3, 1e-3)), 0.25e-3), 1, "paddle");
+  paddle.motion.angular_velocity = Vec3(0, 0, spin);
+  spec.meshes.push_back(paddle);
+  spec.skin = skin;
+  return spec;
+}
+
+}  // namespace
+
+// A wall's rotation counts like its translation: in the neighbour list's rebuild trigger (its far
+// end sweeps the skin without its origin moving) and in the refusal of a wall too fast for the skin.
+TEST(RotatingWall, RotationTriggersRebuildsAndCountsInTheSpeedLimit) {
+  dem::State s;
+  s.add_sphere(0, Vec3(0, 0, 20e-3), 0.5e-3, 2500, 0);
+  const double skin = 0.25e-3, spin = 10.0;  // the paddle's ends (5.1 mm out) move 51 mm/s
+  const dem::Model model = dem::compile_model(paddle_spec(spin, skin), s, "paddle");
+  dem::initialize(model, s);
+  const std::int64_t builds = s.neighbours.builds;
+  // Turning by 0.1 rad moves the far corner 0.51 mm: about four half-skins, four rebuilds.
+  while (s.time < 0.1 / spin) dem::step(model, s);
+  EXPECT_GE(s.neighbours.builds - builds, 3);
+  // Fast enough that its ends cross half the skin in one step: refused, though its origin is still.
+  EXPECT_THROW(dem::compile_model(paddle_spec(0.6 * skin / model.dt / 5.1e-3, skin), s, "paddle"), diefill::InputError);
+}
+
+// A checkpoint belongs to the walls' motion too: resumed under another motion, it is refused.
+TEST(RotatingWall, CheckpointIsRefusedUnderAnotherMotion) {
+  test::TempDir dir;
+  dem::State s;
+  s.add_sphere(0, Vec3(0, 0, 20e-3), 0.5e-3, 2500, 0);
+  const dem::Model model = dem::compile_model(paddle_spec(10, 0.25e-3), s, "paddle");
+  dem::initialize(model, s);
+  for (int n = 0; n < 10; ++n) dem::step(model, s);
+  dem::write_checkpoint(model, s, dir / "run.ckpt");
+  EXPECT_NO_THROW(dem::read_checkpoint(model, dir / "run.ckpt"));
+  EXPECT_THROW(dem::read_checkpoint(dem::compile_model(paddle_spec(11, 0.25e-3), s, "paddle"), dir / "run.ckpt"),
+               diefill::InputError);
+}

@@ -1,5 +1,5 @@
 // Mesh walls where distance fields fail: concave corners, convex edges, and pours that must not
-// leak (PHYSICS.md §5, ARCHITECTURE.md "Walls as signed-distance fields").
+// leak (docs/PHYSICS.md §5, docs/ARCHITECTURE.md "Walls as signed-distance fields").
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -49,7 +49,7 @@ TEST(BundledDies, MeetChordToleranceAndAnalyticVolume) {
 
 TEST(BundledDies, FilesInDiesAreTheGeneratedOnes) {
   test::TempDir dir;
-  for (const std::string name : mesh::bundled_die_names()) {
+  for (const std::string& name : mesh::bundled_die_names()) {
     const auto regenerated = dir / (name + ".stl");
     mesh::write_stl(mesh::bundled_die(name), regenerated, mesh::LengthUnit::mm,
                     "diefill " + name + " cavity, mm");

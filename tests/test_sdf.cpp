@@ -110,3 +110,22 @@ TEST(Sdf, CachedGridReadsBackWithMetadata) {
   const Vec3 p(7e-3, 1e-3, -2e-3);
   EXPECT_EQ(back.sample(p), die.sdf.sample(p));
 }
+
+// The band reaches three voxels into the solid, as OpenVDB's level sets keep: a trilinear sample
+// 1.5 voxels inside a face reads the voxel centres on either side of it, up to 2.5 voxels deep
+// when the face lies between grid planes, which a band of two voxels left out (they read as the
+// band's edge, not the distance).
+TEST(Sdf, InteriorBandHoldsATrilinearSampleOneAndAHalfVoxelsDeep) {
+  const mesh::DieOptions o = default_options();
+  const double top = 10.06e-3;  // between grid planes (the voxel is 0.125 mm)
+  const mesh::TriMesh box = mesh::box_solid(Vec3::Zero(), Vec3(10e-3, 10e-3, top));
+  const mesh::SdfGrid sdf = mesh::build_sdf(box, {o.voxel_m, o.exterior_band_m, o.interior_band_m, false});
+  const mesh::WallField field = sdf.wall_field(box);
+  std::mt19937_64 random(3);
+  std::uniform_real_distribution<double> across(3e-3, 7e-3), depth(1.4, 1.6);
+  for (int n = 0; n < 200; ++n) {
+    const double d = depth(random) * o.voxel_m;
+    const Vec3 p(across(random), across(random), top - d);
+    EXPECT_NEAR(field.trilinear(p), -d, 0.01 * o.voxel_m) << "depth " << d / o.voxel_m << " voxels";
+  }
+}

@@ -80,8 +80,8 @@ TEST_P(SharedDieMesh, LoadsAndPassesTheSignCheckOrNamesItsDefect) {
 }
 
 INSTANTIATE_TEST_SUITE_P(All, SharedDieMesh, ::testing::ValuesIn(shared_dies),
-                         [](const ::testing::TestParamInfo<SharedDie>& info) {
-                           std::string name = info.param.file;
+                         [](const ::testing::TestParamInfo<SharedDie>& param_info) {
+                           std::string name = param_info.param.file;
                            for (char& c : name)
                              if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
                            return name;

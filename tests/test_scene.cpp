@@ -1,0 +1,159 @@
+// Scene files: every key checked against its documented range at load time, naming the key;
+// randomly mutated scenes load or are refused with InputError, never anything else; the settled
+// shoe's cache key follows the keys that shape it and the DEM's code.
+#include <fmt/core.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "pipeline/shoe_fill.hpp"
+#include "scene/physics_keys.hpp"
+#include "scene/pipeline_scene.hpp"
+#include "support.hpp"
+
+namespace {
+
+// Loads the default scene with one override; returns the InputError's text, or "" when it loads.
+std::string refusal(const std::string& override_text) {
+  try {
+    app::load_pipeline_scene(std::nullopt, {override_text});
+    return "";
+  } catch (const diefill::InputError& e) {
+    return e.what();
+  }
+}
+
+// A value just outside a range, below or above (a whole number for an integer key).
+std::vector<double> outside(const app::ValueRange& r, app::KeyType type) {
+  if (type == app::KeyType::integer) return {r.lo - 1, r.hi + 1};
+  const double below = r.lo_open ? r.lo : r.lo - std::max(1.0, std::abs(r.lo)) * 1e-3;
+  const double above = r.hi_open ? r.hi : r.hi + std::max(1.0, std::abs(r.hi)) * 1e-3;
+  return {below, above};
+}
+
+std::string toml_number(double x, app::KeyType type) {
+  return type == app::KeyType::integer ? fmt::format("{}", std::llround(x)) : fmt::format("{:e}", x);
+}
+
+}  // namespace
+
+TEST(SceneKeys, EveryNumberOutsideItsRangeIsRefusedNamingTheKey) {
+  int checked = 0;
+  for (const auto& key : app::pipeline_keys()) {
+    if (key.type != app::KeyType::number && key.type != app::KeyType::integer && key.type != app::KeyType::number_or_auto &&
+        key.type != app::KeyType::vec3)
+      continue;
+    for (double x : outside(key.range, key.type)) {
+      const std::string value = key.type == app::KeyType::vec3 ? fmt::format("[0, 0, {:e}]", x) : toml_number(x, key.type);
+      const std::string why = refusal(key.path() + "=" + value);
+      EXPECT_NE(why.find(key.path()), std::string::npos) << key.path() << " = " << value << ": " << why;
+      ++checked;
+    }
+    EXPECT_FALSE(key.meaning.empty()) << key.path() << " is undocumented";
+  }
+  for (const auto& key : app::material_keys()) {
+    if (key.type != app::KeyType::number) continue;
+    for (double x : outside(key.range, key.type)) {
+      // Materials are an array of tables: a scene file gives them.
+      test::TempDir dir;
+      test::write_text(dir / "scene.toml", fmt::format("[[materials]]\nname = \"powder\"\n{} = {:e}\n\n[[materials]]\nname = \"steel\"\n",
+                                                      key.name, x));
+      try {
+        app::load_pipeline_scene(dir / "scene.toml", {});
+        ADD_FAILURE() << key.name << " = " << x << " loaded";
+      } catch (const diefill::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("materials[0]." + std::string(key.name)), std::string::npos) << e.what();
+      }
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 60);
+}
+
+// The values the review found loading without a word, or refused under the wrong name.
+TEST(SceneKeys, AbsurdValuesFoundByTheReviewAreRefusedByName) {
+  EXPECT_NE(refusal("powder.particle_diameter=1e-300").find("powder.particle_diameter"), std::string::npos);
+  test::TempDir dir;
+  for (const char* line : {"rolling_friction = 1e308", "density = 1e-300", "youngs_modulus = -1"}) {
+    test::write_text(dir / "scene.toml", fmt::format("[[materials]]\nname = \"powder\"\n{}\n\n[[materials]]\nname = \"steel\"\n", line));
+    const test::Run run = test::run_diefill("scene " + (dir / "scene.toml").string());
+    EXPECT_EQ(run.status, 2) << line << ": " << run.output;
+    EXPECT_NE(run.output.find(std::string(line).substr(0, std::string(line).find(' '))), std::string::npos) << run.output;
+  }
+}
+
+// A few hundred random mutations of the fully resolved default scene: each loads (and then every
+// value lies in its range) or is refused with InputError; nothing else may escape.
+TEST(SceneKeys, MutatedScenesLoadOrAreRefusedClearly) {
+  const std::string base = app::describe(app::PipelineScene{});
+  std::vector<std::string> lines;
+  std::stringstream in(base);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  const std::vector<std::string> values = {"-1",  "0",   "1e308", "-1e308", "1e-300", "nan", "inf",  "-inf", "\"text\"",
+                                           "[1, 2, 3]", "true", "9223372036854775807", "{ a = 1 }", "\"auto\"", "3", "0.5"};
+  std::mt19937_64 random(2026);
+  test::TempDir dir;
+  int loaded = 0, refused = 0;
+  for (int n = 0; n < 300; ++n) {
+    std::vector<std::string> mutated = lines;
+    for (int m = 0; m < 1 + int(random() % 3); ++m) {
+      std::string& line = mutated[random() % mutated.size()];
+      const std::size_t eq = line.find(" = ");
+      if (random() % 5 == 0) line = line.substr(0, line.size() / 2);  // cut a line short
+      else if (eq != std::string::npos) line = line.substr(0, eq) + " = " + values[random() % values.size()];
+    }
+    std::string text;
+    for (const std::string& line : mutated) text += line + "\n";
+    test::write_text(dir / "scene.toml", text);
+    try {
+      const app::PipelineScene s = app::load_pipeline_scene(dir / "scene.toml", {});
+      for (const auto& key : app::pipeline_keys()) {
+        if (key.type == app::KeyType::number || key.type == app::KeyType::integer) {
+          EXPECT_TRUE(key.range.contains(std::get<double>(key.get(s)))) << key.path() << " in\n" << text;
+        }
+      }
+      ++loaded;
+    } catch (const diefill::InputError&) {
+      ++refused;
+    }
+  }
+  std::printf("mutated scenes: %d loaded, %d refused\n", loaded, refused);
+  EXPECT_GT(refused, 100);
+  EXPECT_GT(loaded, 10);
+}
+
+// The settled shoe is reused only while everything that shaped it is unchanged: the settling
+// keys and the DEM's code; the shoe's motion after settling does not count.
+TEST(SettledShoe, KeyFollowsTheSettlingKeysAndTheDemCode) {
+  const app::PipelineScene scene;
+  const app::SettledShoeInputs inputs{"die", {0.8e-3, 0.44e-3, 8, 1000}, {}, 0, 0};
+  const std::string key = app::settled_shoe_key(scene, inputs, "dem-code-a");
+  EXPECT_EQ(app::settled_shoe_key(scene, inputs, "dem-code-a"), key);
+  EXPECT_NE(app::settled_shoe_key(scene, inputs, "dem-code-b"), key) << "changed DEM sources";
+  app::PipelineScene other = scene;
+  other.shoe_settle_time *= 1.5;
+  EXPECT_NE(app::settled_shoe_key(other, inputs, "dem-code-a"), key) << "a settling key";
+  other = scene;
+  other.spec.materials[0].sliding_friction = 0.45;
+  EXPECT_NE(app::settled_shoe_key(other, inputs, "dem-code-a"), key) << "a material";
+  other = scene;
+  other.speed = 0.3;
+  other.die_settle_time = 0.2;
+  other.density_voxel = 1e-3;
+  other.threads = 2;
+  EXPECT_EQ(app::settled_shoe_key(other, inputs, "dem-code-a"), key) << "keys that act after the shoe has settled";
+}
+
+// docs/INTERFACE.md's key reference is the table's own, so the two cannot drift apart.
+TEST(SceneKeys, InterfaceDocumentListsEveryKeyAsTheTableHasIt) {
+  const std::string doc = test::read_text(test::source_dir() / "docs" / "INTERFACE.md");
+  const std::string begin = "<!-- generated by `diefill scene --keys`; tests/test_scene.cpp checks it is current -->\n";
+  const std::size_t from = doc.find(begin), to = doc.find("<!-- end of generated keys -->");
+  ASSERT_NE(from, std::string::npos);
+  ASSERT_NE(to, std::string::npos);
+  EXPECT_EQ(doc.substr(from + begin.size(), to - from - begin.size()), app::scene_keys_markdown())
+      << "regenerate the section with `diefill scene --keys`";
+}
