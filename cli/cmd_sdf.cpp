@@ -43,16 +43,19 @@ int run_sdf(const SdfCommand& c) {
     const mesh::WallField field = die.sdf.wall_field(die.solid);
     const mesh::SdfVerification v = mesh::verify_sdf(field, die.solid, exact, c.verify, c.seed);
     fmt::print("verify: {} points in the band (seed {}), {} farther than a voxel from a sharp "
-               "edge, {} with |exact| > 0.5 voxel\n",
-               v.samples, c.seed, v.smooth_samples, v.sign_checked);
+               "edge, {} with |exact| > 0.5 voxel, {} outside or within a voxel inside (where grain centres go)\n",
+               v.samples, c.seed, v.smooth_samples, v.sign_checked, v.reachable_samples);
     auto show = [&](const char* what, const mesh::SdfErrors& e) {
       fmt::print("  {}: |SDF - exact| max {:.3g} voxel, mean {:.3g} voxel; away from sharp edges "
                  "max {:.3g} voxel at ({:.4f}, {:.4f}, {:.4f}) mm; sign disagreements {}\n",
                  what, e.max_voxels, e.mean_voxels, e.max_smooth_voxels,
                  e.worst_smooth_point.x() / mm, e.worst_smooth_point.y() / mm,
                  e.worst_smooth_point.z() / mm, e.sign_disagreements);
+      if (e.sign_disagreements > 0)
+        fmt::print("    first sign disagreement at ({:.4f}, {:.4f}, {:.4f}) mm\n", e.first_sign_disagreement.x() / mm,
+                   e.first_sign_disagreement.y() / mm, e.first_sign_disagreement.z() / mm);
     };
-    show("wall query (what the simulation uses)", v.query);
+    show("wall query (what the simulation uses; errors where grain centres go, signs everywhere)", v.query);
     show("grid, trilinear", v.grid);
   }
   if (!c.output.empty()) {

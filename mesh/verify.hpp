@@ -14,13 +14,16 @@ struct SdfErrors {
   double max_smooth_voxels = 0;  // over samples farther than one voxel from a sharp edge
   Vec3 worst_smooth_point = Vec3::Zero();  // where that maximum occurs [m]
   std::size_t sign_disagreements = 0;      // among samples with |exact| > 0.5 voxel
+  Vec3 first_sign_disagreement = Vec3::Zero();  // where the first one lies [m]
 };
 
 struct SdfVerification {
   std::size_t samples = 0;         // points in the band (all 8 trilinear corners active)
   std::size_t smooth_samples = 0;  // samples farther than one voxel from a sharp edge
   std::size_t sign_checked = 0;    // samples with |exact| > 0.5 voxel
-  SdfErrors query;                 // the simulation's wall query (WallField::signed_distance)
+  std::size_t reachable_samples = 0;  // samples outside or less than a voxel inside the solid
+  SdfErrors query;                 // the simulation's wall query (WallField::signed_distance): its
+                                   // errors over the reachable samples, its signs over all
   SdfErrors grid;                  // plain trilinear interpolation of the .vdb grid
 };
 

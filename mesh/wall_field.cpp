@@ -238,6 +238,38 @@ int WallField::local_minima(const Vec3& p, double range, SurfacePoint* out, int 
   return local_minima_from(p, range, triangles_near, count, out, capacity);
 }
 
+int WallField::descend_all(const Vec3& p, const std::int32_t* triangles_near, int count, SurfacePoint* out) const {
+  for (int c = 0; c < count; ++c) out[c] = descend(p, triangles_near[c]);
+  return count;
+}
+
+// The descents from the candidates of p's cell end at local minima of the distance. Where they
+// disagree in sign, one of them lies on a part of the surface that p sees from behind while
+// another surface is closer: the cell's candidates may then have missed the closest triangle
+// (on a feature thinner than a voxel, say), so the 3x3x3 voxels around p are asked too. The
+// nearest minimum found decides the sign, and minima of the other sign are dropped: a point is
+// inside or outside, never both.
+int WallField::consistent_minima(const Vec3& p, const std::int32_t* triangles_near, int count, SurfacePoint* found) const {
+  int n = descend_all(p, triangles_near, count, found);
+  const auto mixed = [&] {
+    for (int c = 1; c < n; ++c)
+      if ((found[c].distance < 0) != (found[0].distance < 0)) return true;
+    return false;
+  };
+  if (mixed()) {
+    std::int32_t wider[27];
+    n = descend_all(p, wider, candidates(p, 1, wider, 27), found);
+  }
+  int nearest = 0;
+  for (int c = 1; c < n; ++c)
+    if (std::abs(found[c].distance) < std::abs(found[nearest].distance)) nearest = c;
+  const bool inside = n > 0 && found[nearest].distance < 0;
+  int kept = 0;
+  for (int c = 0; c < n; ++c)
+    if ((found[c].distance < 0) == inside) found[kept++] = found[c];
+  return kept;
+}
+
 int WallField::local_minima_from(const Vec3& p, double range, const std::int32_t* triangles_near, int count,
                                  SurfacePoint* out, int capacity) const {
   // Minima with nearly parallel normals lie on one smooth surface: a tessellated curve seen
@@ -245,9 +277,11 @@ int WallField::local_minima_from(const Vec3& p, double range, const std::int32_t
   // would double the force there. Only the deepest of them is a contact; minima whose normals
   // differ by more than `smooth_angle` (a concave corner) are contacts each.
   static const double same_surface = std::cos(smooth_angle_deg * 3.14159265358979323846 / 180.0);
+  SurfacePoint minima[27];
+  const int n = consistent_minima(p, triangles_near, count, minima);
   int found = 0;
-  for (int c = 0; c < count; ++c) {
-    const SurfacePoint s = descend(p, triangles_near[c]);
+  for (int c = 0; c < n; ++c) {
+    const SurfacePoint& s = minima[c];
     if (s.distance > range) continue;
     int merged = -1;
     for (int f = 0; f < found && merged < 0; ++f)
@@ -264,11 +298,11 @@ int WallField::local_minima_from(const Vec3& p, double range, const std::int32_t
 bool WallField::nearest(const Vec3& p, int reach, SurfacePoint& out) const {
   std::int32_t triangles_near[27];
   const int count = candidates(p, reach, triangles_near, 27);
-  for (int c = 0; c < count; ++c) {
-    const SurfacePoint s = descend(p, triangles_near[c]);
-    if (c == 0 || std::abs(s.distance) < std::abs(out.distance)) out = s;
-  }
-  return count > 0;
+  SurfacePoint minima[27];
+  const int n = consistent_minima(p, triangles_near, count, minima);
+  for (int c = 0; c < n; ++c)
+    if (c == 0 || std::abs(minima[c].distance) < std::abs(out.distance)) out = minima[c];
+  return n > 0;
 }
 
 double WallField::signed_distance(const Vec3& p) const {

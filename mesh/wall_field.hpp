@@ -98,6 +98,10 @@ struct WallField {
   // Distinct closest triangles of the voxels around p (see nearest); returns their number.
   int candidates(const Vec3& p, int reach, std::int32_t* out, int capacity) const;
   SurfacePoint descend(const Vec3& p, int triangle) const;
+  int descend_all(const Vec3& p, const std::int32_t* triangles_near, int count, SurfacePoint* out) const;
+  // The minima from these candidates, widened to the 3x3x3 voxels when they disagree in sign,
+  // with those of the nearest one's sign kept (at most 27).
+  int consistent_minima(const Vec3& p, const std::int32_t* triangles_near, int count, SurfacePoint* found) const;
 };
 
 }  // namespace mesh

@@ -23,7 +23,9 @@ mesh::DieOptions die_options(const PipelineScene& s, const GrainSizing& grains, 
   mesh::DieOptions o = mesh::die_options_for_grains(r, 0.5 * r, s.die_voxel_fraction * r);
   o.unit = source.file.unit;
   o.role = mesh::WallRole::cavity;
-  const double margin = 2e-3 + 2 * r;
+  // Room beside the shoe: grains that pass under its walls (the strike-off) stay on the table
+  // rather than falling off a table the size of the shoe (two radii let one grain in 2000 off).
+  const double margin = 2e-3 + 6 * r;
   o.table = mesh::TableExtent{shoe.x_start - 0.5 * shoe.length - s.shoe_wall - margin,
                               shoe.y_centre - 0.5 * shoe.width - s.shoe_wall - margin,
                               shoe.x_end + 0.5 * shoe.length + s.shoe_wall + margin,

@@ -209,7 +209,7 @@ void stability(const PipelineScene& scene, bool reduced, Output& out) {
   const Powder powder = powder_of(scene);
   const std::filesystem::path work = out.work();
   const std::vector<double> time_steps = reduced ? std::vector<double>{0.15, 2.0} : std::vector<double>{0.1, 0.2, 0.4, 0.7, 1.0, 1.5, 2.5};
-  const std::vector<double> voxels = reduced ? std::vector<double>{0.25, 4.0} : std::vector<double>{0.25, 0.5, 1, 2, 4, 8};
+  const std::vector<double> voxels = reduced ? std::vector<double>{0.25, 8.0} : std::vector<double>{0.25, 0.5, 1, 2, 4, 8, 16};
   const std::vector<double> wall_steps = reduced ? std::vector<double>{0.5, 2.0} : std::vector<double>{0.25, 0.5, 0.9, 1.1, 2, 4};
   const std::vector<double> cavity = reduced ? std::vector<double>{0.5, 1.2} : std::vector<double>{0.3, 0.5, 0.8, 1.0, 1.2};
 
