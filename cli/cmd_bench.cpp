@@ -87,14 +87,6 @@ dem::State read_lammps_dump(const fs::path& path, const dem::Material& m) {
   return s;
 }
 
-std::size_t bytes_of(const dem::State& s) {
-  auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-  const auto& nl = s.neighbours;
-  const auto& pf = s.pair_forces;
-  return b(s.id) + b(s.x) + b(s.v) + b(s.w) + b(s.f) + b(s.torque) + b(s.radius) + b(s.mass) + b(s.inertia) +
-         b(s.material) + b(s.active) + b(s.wall_slots) + b(nl.row_start) + b(nl.partner) + b(nl.history) +
-         b(nl.reverse_start) + b(nl.reverse_pair) + b(nl.near_wall) + b(nl.x_at_build) + b(pf.force) + b(pf.torque);
-}
 
 json time_case(const std::string& name, const dem::Model& model, const dem::State& pack, int steps,
                const std::vector<int>& thread_counts) {
@@ -129,7 +121,7 @@ json time_case(const std::string& name, const dem::Model& model, const dem::Stat
                       {"monitor", times.monitor}}}});
     diefill::log::info("bench {}: {} threads, {:.3g} particle-steps/s", name, threads, rate);
     if (threads == thread_counts.back())
-      runs.back()["bytes_per_particle"] = double(bytes_of(s)) / double(s.size());
+      runs.back()["bytes_per_particle"] = double(s.memory_bytes()) / double(s.size());
   }
   return {{"case", name}, {"grains", pack.size()}, {"dt_s", model.dt}, {"runs", runs}};
 }
@@ -182,6 +174,44 @@ std::pair<dem::Model, dem::State> ring_pack(std::size_t count, const fs::path& c
   return {dem::compile_model(spec, fresh, "bench"), fresh};
 }
 
+// The scaling case: dense settled beds of `count` grains cut from the settled LIGGGHTS pack (the
+// grains of a square column of it, one column per tile, tiles side by side a grain apart in a
+// box of planes), so that every size is the same powder in the same state, and no hour-long pour
+// is needed for half a million grains. Tiles hold the column's grains lowest first.
+std::pair<dem::Model, dem::State> tiled_pack(const dem::State& source, std::size_t count) {
+  constexpr double column = 30e-3;  // the largest square the 44 mm cylinder holds, nearly
+  std::vector<std::size_t> in_column;
+  for (std::size_t i = 0; i < source.size(); ++i)
+    if (std::abs(source.x[i].x()) < 0.5 * column && std::abs(source.x[i].y()) < 0.5 * column) in_column.push_back(i);
+  std::sort(in_column.begin(), in_column.end(), [&](std::size_t a, std::size_t b) { return source.x[a].z() < source.x[b].z(); });
+  const std::size_t per_tile = in_column.size();
+  const std::size_t tiles = (count + per_tile - 1) / per_tile;
+  const int side = int(std::ceil(std::sqrt(double(tiles))));
+  const double pitch = column + 1e-3, z0 = source.x[in_column.front()].z() - source.radius[in_column.front()];
+  // A single tile smaller than the column: the square of the same height that holds `count`.
+  const double shrink = tiles == 1 ? std::sqrt(double(count) / double(per_tile)) : 1.0;
+  dem::State s;
+  for (std::size_t t = 0; t < tiles && s.size() < count; ++t) {
+    const dem::Vec3 shift(double(int(t) % side) * pitch, double(int(t) / side) * pitch, -z0);
+    for (std::size_t i : in_column) {
+      if (s.size() == count) break;
+      if (shrink < 1 && (std::abs(source.x[i].x()) > 0.5 * column * shrink || std::abs(source.x[i].y()) > 0.5 * column * shrink)) continue;
+      s.add_sphere(std::int64_t(s.size()), source.x[i] + shift, source.radius[i], 2500, 0);
+    }
+  }
+  dem::ModelSpec spec = reference_spec();
+  spec.gravity = dem::Vec3(0, 0, -9.81);
+  const double lo = -0.5 * column * shrink, hi_x = lo + double(std::min<int>(side, int(tiles)) - 1) * pitch + column * shrink;
+  const double hi_y = lo + double((int(tiles) + side - 1) / side - 1) * pitch + column * shrink;
+  spec.planes = {{dem::Vec3(0, 0, 0), dem::Vec3::UnitZ(), 0, "floor"},
+                 {dem::Vec3(lo, 0, 0), dem::Vec3::UnitX(), 0, "side"},
+                 {dem::Vec3(hi_x, 0, 0), -dem::Vec3::UnitX(), 0, "side"},
+                 {dem::Vec3(0, lo, 0), dem::Vec3::UnitY(), 0, "side"},
+                 {dem::Vec3(0, hi_y, 0), -dem::Vec3::UnitY(), 0, "side"}};
+  spec.domain = {dem::Vec3(lo, lo, 0) - dem::Vec3::Constant(2e-3), dem::Vec3(hi_x, hi_y, 0.1) + dem::Vec3::Constant(2e-3)};
+  return {dem::compile_model(spec, s, "bench scaling"), s};
+}
+
 }  // namespace
 
 int run_bench(const BenchCommand& c) {
@@ -214,6 +244,15 @@ int run_bench(const BenchCommand& c) {
       r["container"] = c.stl.string();
       r["container_triangles"] = die.after.triangles;
       results["cases"].push_back(r);
+    } else if (name == "scaling") {
+      if (c.pack.empty())
+        throw diefill::InputError("bench scaling", "--pack", "the scaling case tiles the settled LIGGGHTS pack",
+                                  "Run bench/scaling.sh, which prepares it");
+      const dem::State source = read_lammps_dump(c.pack, reference_material());
+      for (std::size_t count : c.sizes) {
+        auto [model, pack] = tiled_pack(source, count);
+        results["cases"].push_back(time_case(fmt::format("scaling-{}", count), model, pack, c.steps, thread_counts));
+      }
     } else if (name == "run-ring") {
       app::PipelineScene scene = load_pipeline_scene(std::nullopt, {});
       scene.out = c.cache / "run-ring";
@@ -227,7 +266,7 @@ int run_bench(const BenchCommand& c) {
                                   {"fill_ratio", run.report["fill"]["fill_ratio"]},
                                   {"timing", run.report["timing"]}});
     } else {
-      throw diefill::InputError("bench", name, "is not a benchmark case", "Use ring-10k, ring-100k, liggghts or run-ring");
+      throw diefill::InputError("bench", name, "is not a benchmark case", "Use ring-10k, ring-100k, liggghts, scaling or run-ring");
     }
   }
   const std::string text = results.dump(2) + "\n";

@@ -61,6 +61,7 @@ struct BenchCommand {
   std::filesystem::path cache = "out/bench";
   std::filesystem::path pack;  // liggghts: the settled pack (LAMMPS dump)
   std::filesystem::path stl;   // liggghts: the container (mm)
+  std::vector<std::size_t> sizes = {5000, 15000, 50000, 150000, 500000};  // scaling: grain counts
 };
 int run_bench(const BenchCommand& command);
 

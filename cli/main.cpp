@@ -58,13 +58,14 @@ void add_simulate(CLI::App& root, app::SimulateCommand& c, std::function<int()>&
 
 void add_bench(CLI::App& root, app::BenchCommand& c, std::function<int()>& action) {
   CLI::App* cmd = root.add_subcommand("bench", "Performance cases; JSON results");
-  cmd->add_option("CASE", c.cases, "ring-10k, ring-100k (default both), liggghts, run-ring (the default pipeline on the ring, end to end)");
+  cmd->add_option("CASE", c.cases, "ring-10k, ring-100k (default both), liggghts, scaling (tiles of the LIGGGHTS pack, 5k to 500k grains), run-ring (the default pipeline on the ring, end to end)");
   cmd->add_option("--json", c.json_out, "Write the results here instead of standard output");
   cmd->add_option("--threads", c.threads, "Thread counts to time (default 1 2)");
   cmd->add_option("--steps", c.steps, "Timed steps per run")->capture_default_str();
   cmd->add_option("--cache", c.cache, "Folder for prepared packs and SDFs")->capture_default_str();
   cmd->add_option("--pack", c.pack, "liggghts: settled pack (LAMMPS dump: id x y z radius vx vy vz)");
   cmd->add_option("--stl", c.stl, "liggghts: container mesh (mm)");
+  cmd->add_option("--sizes", c.sizes, "scaling: grain counts")->capture_default_str();
   cmd->callback([&] { action = [&] { return app::run_bench(c); }; });
 }
 

@@ -9,7 +9,7 @@ namespace dem {
 
 namespace {
 
-constexpr char magic[8] = {'D', 'F', 'C', 'K', 'P', 'T', '0', '3'};
+constexpr char magic[8] = {'D', 'F', 'C', 'K', 'P', 'T', '0', '4'};
 
 struct Writer {
   std::string bytes;
@@ -72,10 +72,13 @@ void fields(IO& io, S& s) {
   auto& nl = s.neighbours;
   io.array(nl.row_start);
   io.array(nl.partner);
-  io.array(nl.history);
+  io.array(nl.tangential);
+  io.array(nl.rolling);
   io.array(nl.touching);
-  io.array(nl.reverse_start);
-  io.array(nl.reverse_pair);
+  io.value(nl.block_size);
+  io.array(nl.cross_start);
+  io.array(nl.cross_reverse_start);
+  io.array(nl.cross_reverse);
   io.array(nl.near_wall);
   io.array(nl.x_at_build);
   io.array(nl.wall_shift_at_build);
@@ -114,9 +117,9 @@ State read_checkpoint(const Model& model, const std::filesystem::path& path) {
   State s;
   fields(r, s);
   if (!r.in) throw diefill::InputError(path.string(), "", "the checkpoint is truncated", "Start afresh");
-  // Per-pair force buffers are scratch, refilled by the next force stage.
-  s.pair_forces.force.assign(s.neighbours.partner.size(), Vec3::Zero());
-  s.pair_forces.torque.assign(s.neighbours.partner.size(), Vec3::Zero());
+  // The cross pairs' force buffers are scratch, refilled by the next force stage.
+  s.cross_forces.force.assign(s.neighbours.cross_reverse.size(), Vec3::Zero());
+  s.cross_forces.torque.assign(s.neighbours.cross_reverse.size(), Vec3::Zero());
   return s;
 }
 

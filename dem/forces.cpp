@@ -11,12 +11,12 @@ namespace dem {
 namespace {
 
 // Contacts gathered from consecutive rows, as columns (one array per quantity), so that the
-// law runs over them as a loop the compiler vectorises; capacity set so that a batch (about
-// 60 kB) stays in the first-level cache.
-struct ContactBatch {
-  static constexpr int capacity = 192;
+// law runs over them as a loop the compiler vectorises. The columns start on cache lines, so
+// that the vector loads never straddle two, wherever the batch happens to lie.
+struct alignas(64) ContactBatch {
+  static constexpr int capacity = 192;  // a multiple of 8: every column a whole number of lines
   int size = 0;
-  std::int32_t pair[capacity], row[capacity];
+  alignas(64) std::int32_t pair[capacity], row[capacity], partner[capacity], slot[capacity];
   // in: separation x_i - x_j, radii, masses, velocities, history, pair parameters
   double dx[capacity], dy[capacity], dz[capacity], ri[capacity], rj[capacity], mi[capacity], mj[capacity];
   double vix[capacity], viy[capacity], viz[capacity], wix[capacity], wiy[capacity], wiz[capacity];
@@ -31,13 +31,15 @@ struct ContactBatch {
 };
 
 // The law over a batch; each lane is one contact, computed exactly as alone. With one material
-// for every grain (`common` given) the pairs' parameters are that pair's, not gathered.
-template <class Law>
-[[gnu::flatten]] void evaluate(ContactBatch& b, double dt, const PairParams* common) {
-  const PairParams shared = common ? *common : PairParams{};
+// for every grain (Common) the pairs' parameters are that pair's, not gathered: a compile-time
+// choice, since a run-time one left the loop blending each parameter between a gathered column
+// and a copy on the stack, and the stack loads ran at a third of the speed in two processes of
+// three (the stack's placement decided; bench/results/liggghts_50k.json, README "Speed").
+template <class Law, bool Common>
+[[gnu::flatten]] void evaluate(ContactBatch& b, double dt, const PairParams& common) {
   for (int k = 0; k < b.size; ++k) {
-    PairParams p = shared;
-    if (!common) {
+    PairParams p = common;
+    if constexpr (!Common) {
       p.e_star = b.e_star[k], p.damping = b.damping[k], p.mu_s = b.mu_s[k], p.mu_r = b.mu_r[k];
       p.k_linear = b.k_linear[k], p.kt_over_kn = b.kt_over_kn[k], p.sqrt_kt_over_kn = b.sqrt_kt_over_kn[k];
       p.cohesion = b.cohesion[k];
@@ -73,101 +75,148 @@ template <class Law>
   }
 }
 
-// The rows [begin, end) that `omp for schedule(static)` gives this thread in a loop of n: the
-// same grains as every other pass over them.
-std::pair<std::size_t, std::size_t> static_rows(std::size_t n) {
+// The part of n items (blocks) that `omp for schedule(static)` gives this thread: about the
+// grains the other passes give it, so that they stay in its core's cache (dynamic chunks moved
+// them between cores: 17 % slower on two threads).
+std::pair<std::size_t, std::size_t> static_range(std::size_t n) {
   const std::size_t threads = std::size_t(omp_get_num_threads()), t = std::size_t(omp_get_thread_num());
   const std::size_t share = n / threads, extra = n % threads;
   const std::size_t begin = t * share + std::min(t, extra);
   return {begin, begin + share + (t < extra ? 1 : 0)};
 }
 
-// Rows in parallel: the owner i sums its own share (gravity first, then its pairs in order)
-// into f[i]; the partner's share goes to the pair buffer. A thread gathers the touching pairs
-// of its rows into a batch, evaluates the batch, then adds the results in row and pair order:
-// the same sums, bit for bit, as one contact at a time, whatever the thread count. Every pass
-// over the grains splits them statically, alike: each thread meets the same grains in every
-// stage, which stay in its core's cache (dynamic chunks moved them between cores: 17 % slower
-// on two threads).
+// Blocks in parallel (state.hpp, NeighbourList): a thread takes whole blocks, sets their grains'
+// forces to gravity, then goes through their rows in order, gathering the touching pairs into a
+// batch, evaluating it, and adding the results in row and pair order: to the row's grain, and to
+// its partner directly when the partner is in the same block, else to the cross pair's buffer.
+// Every grain's force is thus gravity, the shares of lower rows of its block in row order, its
+// own pairs in order, then (sum_forces) the cross shares in pair order: the same sums, bit for
+// bit, whatever the thread count.
+// A batch's results added in row and pair order: to the row's grain, to its partner when in
+// the same block (slot < 0), else to the cross pair's buffer; histories written back. Returns
+// the largest overlap over the smaller radius.
+double apply_batch(const ContactBatch& b, State& s, bool tangential, bool rolling) {
+  NeighbourList& nl = s.neighbours;
+  Vec3* const f = s.f.data();
+  Vec3* const torque = s.torque.data();
+  double max_overlap = 0;
+  for (int k = 0; k < b.size; ++k) {
+    const std::size_t i = std::size_t(b.row[k]), p = std::size_t(b.pair[k]);
+    const Vec3 force(b.fx[k], b.fy[k], b.fz[k]), partner_torque(b.tjx[k], b.tjy[k], b.tjz[k]);
+    f[i] += force;
+    torque[i] += Vec3(b.tix[k], b.tiy[k], b.tiz[k]);
+    if (b.slot[k] < 0) {
+      const std::size_t j = std::size_t(b.partner[k]);
+      f[j] += -force;
+      torque[j] += partner_torque;
+    } else {
+      s.cross_forces.force[std::size_t(b.slot[k])] = -force;
+      s.cross_forces.torque[std::size_t(b.slot[k])] = partner_torque;
+    }
+    if (tangential) nl.tangential[p] = Vec3(b.tx[k], b.ty[k], b.tz[k]);
+    if (rolling) nl.rolling[p] = Vec3(b.rx[k], b.ry[k], b.rz[k]);
+    max_overlap = std::max(max_overlap, b.overlap_rel[k]);
+  }
+  return max_overlap;
+}
+
+// Blocks in parallel (state.hpp, NeighbourList): a thread takes whole blocks, sets their grains'
+// forces to gravity, then goes through their rows in order, gathering the touching pairs into a
+// batch, evaluating it, and adding the results in row and pair order (apply_batch). Every
+// grain's force is thus gravity, the shares of lower rows of its block in row order, its own
+// pairs in order, then (sum_forces) the cross shares in pair order: the same sums, bit for bit,
+// whatever the thread count. The loop reads the grains through local pointers and keeps its
+// counters in registers: a store per pair to the touching flags or to a counter in memory let
+// the compiler assume any array pointer changed, and tied the loop to stack addresses.
 template <class Law>
 void pair_forces(const Model& model, State& s) {
   NeighbourList& nl = s.neighbours;
-  PairForces& pf = s.pair_forces;
   const double dt = model.dt;
+  const bool tangential = !nl.tangential.empty(), rolling = !nl.rolling.empty();
   double max_overlap = 0;
   std::int64_t contacts = 0;
   const PairParams* common = model.materials.size() == 1 ? &model.params(0, 0) : nullptr;
+  const std::size_t n = s.size(), block = std::size_t(nl.block_size);
+  const Vec3* const x = s.x.data();
+  const Vec3* const v = s.v.data();
+  const Vec3* const w = s.w.data();
+  const double* const radius = s.radius.data();
+  const double* const mass = s.mass.data();
+  const std::int32_t* const partner = nl.partner.data();
+  std::uint8_t* const touching = nl.touching.data();
 #pragma omp parallel reduction(max : max_overlap) reduction(+ : contacts)
   {
     static thread_local ContactBatch batch;
     ContactBatch& b = batch;
-    b.size = 0;
-    auto flush = [&] {
-      evaluate<Law>(b, dt, common);
-      for (int k = 0; k < b.size; ++k) {
-        const std::size_t i = std::size_t(b.row[k]), p = std::size_t(b.pair[k]);
-        const Vec3 force(b.fx[k], b.fy[k], b.fz[k]);
-        s.f[i] += force;
-        s.torque[i] += Vec3(b.tix[k], b.tiy[k], b.tiz[k]);
-        pf.force[p] = -force;
-        pf.torque[p] = Vec3(b.tjx[k], b.tjy[k], b.tjz[k]);
-        nl.history[p].tangential = Vec3(b.tx[k], b.ty[k], b.tz[k]);
-        nl.history[p].rolling = Vec3(b.rx[k], b.ry[k], b.rz[k]);
-        max_overlap = std::max(max_overlap, b.overlap_rel[k]);
-      }
-      contacts += b.size;
-      b.size = 0;
+    int count = 0;
+    double largest = 0;
+    std::int64_t evaluated = 0;
+    const auto flush = [&] {
+      b.size = count;
+      if (common) evaluate<Law, true>(b, dt, *common);
+      else evaluate<Law, false>(b, dt, PairParams{});
+      largest = std::max(largest, apply_batch(b, s, tangential, rolling));
+      evaluated += count;
+      count = 0;
     };
-    const auto [begin, end] = static_rows(s.size());
-    for (std::size_t i = begin; i < end; ++i) {
-      if (!s.active[i]) {
-        s.f[i].setZero();
-        s.torque[i].setZero();
-        continue;  // an inactive grain has no listed pairs
-      }
+    const auto [first_block, last_block] = static_range(nl.blocks());
+    for (std::size_t blk = first_block; blk < last_block; ++blk) {
+      const std::size_t lo = blk * block, hi = std::min(n, lo + block);
       // A clump's weight acts at its centre of mass, which its members' centres need not share.
-      s.f[i] = s.body[i] < 0 ? Vec3(s.mass[i] * model.gravity) : Vec3::Zero();
-      s.torque[i].setZero();
-      const Vec3 xi = s.x[i], vi = s.v[i], wi = s.w[i];
-      const double ri = s.radius[i], mi = s.mass[i];
-      const int mat_i = s.material[i];
-      for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p) {
-        const std::size_t j = std::size_t(nl.partner[std::size_t(p)]);
-        const Vec3 d = xi - s.x[j];
-        const double reach = ri + s.radius[j];
-        // Lists hold active grains only: grains are lost at rebuilds, which rebuild the lists.
-        if (d.squaredNorm() >= reach * reach) {
-          // A contact that just ended clears its history and its share; most listed pairs
-          // were apart already and cost only this flag.
-          if (nl.touching[std::size_t(p)]) {
-            nl.touching[std::size_t(p)] = 0;
-            nl.history[std::size_t(p)] = ContactHistory{};
-            pf.force[std::size_t(p)].setZero();
-            pf.torque[std::size_t(p)].setZero();
+      for (std::size_t i = lo; i < hi; ++i) {
+        s.f[i] = s.active[i] && s.body[i] < 0 ? Vec3(mass[i] * model.gravity) : Vec3::Zero();
+        s.torque[i].setZero();
+      }
+      for (std::size_t i = lo; i < hi; ++i) {
+        if (!s.active[i]) continue;  // an inactive grain has no listed pairs
+        const Vec3 xi = x[i], vi = v[i], wi = w[i];
+        const double ri = radius[i], mi = mass[i];
+        const int mat_i = s.material[i];
+        std::int32_t cross_slot = nl.cross_start[i];
+        const std::int32_t row_end = nl.row_start[i + 1];
+        for (std::int32_t p = nl.row_start[i]; p < row_end; ++p) {
+          const std::size_t j = std::size_t(partner[p]);
+          const std::int32_t slot = j < hi ? -1 : cross_slot++;
+          const Vec3 d = xi - x[j];
+          const double reach = ri + radius[j];
+          // Lists hold active grains only: grains are lost at rebuilds, which rebuild the lists.
+          if (d.squaredNorm() >= reach * reach) {
+            // A contact that just ended clears its history and its share; most listed pairs
+            // were apart already and cost only this flag.
+            if (touching[p]) {
+              touching[p] = 0;
+              if (tangential) nl.tangential[std::size_t(p)].setZero();
+              if (rolling) nl.rolling[std::size_t(p)].setZero();
+              if (slot >= 0) s.cross_forces.force[std::size_t(slot)].setZero(), s.cross_forces.torque[std::size_t(slot)].setZero();
+            }
+            continue;
           }
-          continue;
-        }
-        nl.touching[std::size_t(p)] = 1;
-        if (b.size == ContactBatch::capacity) flush();
-        const int k = b.size++;
-        const ContactHistory& h = nl.history[std::size_t(p)];
-        const Vec3 vj = s.v[j], wj = s.w[j];
-        b.pair[k] = std::int32_t(p), b.row[k] = std::int32_t(i);
-        b.dx[k] = d.x(), b.dy[k] = d.y(), b.dz[k] = d.z();
-        b.ri[k] = ri, b.rj[k] = s.radius[j], b.mi[k] = mi, b.mj[k] = s.mass[j];
-        b.vix[k] = vi.x(), b.viy[k] = vi.y(), b.viz[k] = vi.z(), b.wix[k] = wi.x(), b.wiy[k] = wi.y(), b.wiz[k] = wi.z();
-        b.vjx[k] = vj.x(), b.vjy[k] = vj.y(), b.vjz[k] = vj.z(), b.wjx[k] = wj.x(), b.wjy[k] = wj.y(), b.wjz[k] = wj.z();
-        b.tx[k] = h.tangential.x(), b.ty[k] = h.tangential.y(), b.tz[k] = h.tangential.z();
-        b.rx[k] = h.rolling.x(), b.ry[k] = h.rolling.y(), b.rz[k] = h.rolling.z();
-        if (!common) {
-          const PairParams& pp = model.params(mat_i, s.material[j]);
-          b.e_star[k] = pp.e_star, b.damping[k] = pp.damping, b.mu_s[k] = pp.mu_s, b.mu_r[k] = pp.mu_r;
-          b.k_linear[k] = pp.k_linear, b.kt_over_kn[k] = pp.kt_over_kn, b.sqrt_kt_over_kn[k] = pp.sqrt_kt_over_kn;
-          b.cohesion[k] = pp.cohesion;
+          if (!touching[p]) touching[p] = 1;
+          if (count == ContactBatch::capacity) flush();
+          const int k = count++;
+          const Vec3 vj = v[j], wj = w[j];
+          const Vec3 t = tangential ? nl.tangential[std::size_t(p)] : Vec3::Zero();
+          const Vec3 r = rolling ? nl.rolling[std::size_t(p)] : Vec3::Zero();
+          b.pair[k] = p, b.row[k] = std::int32_t(i), b.partner[k] = std::int32_t(j), b.slot[k] = slot;
+          b.dx[k] = d.x(), b.dy[k] = d.y(), b.dz[k] = d.z();
+          b.ri[k] = ri, b.rj[k] = radius[j], b.mi[k] = mi, b.mj[k] = mass[j];
+          b.vix[k] = vi.x(), b.viy[k] = vi.y(), b.viz[k] = vi.z(), b.wix[k] = wi.x(), b.wiy[k] = wi.y(), b.wiz[k] = wi.z();
+          b.vjx[k] = vj.x(), b.vjy[k] = vj.y(), b.vjz[k] = vj.z(), b.wjx[k] = wj.x(), b.wjy[k] = wj.y(), b.wjz[k] = wj.z();
+          b.tx[k] = t.x(), b.ty[k] = t.y(), b.tz[k] = t.z();
+          b.rx[k] = r.x(), b.ry[k] = r.y(), b.rz[k] = r.z();
+          if (!common) {
+            const PairParams& pp = model.params(mat_i, s.material[j]);
+            b.e_star[k] = pp.e_star, b.damping[k] = pp.damping, b.mu_s[k] = pp.mu_s, b.mu_r[k] = pp.mu_r;
+            b.k_linear[k] = pp.k_linear, b.kt_over_kn[k] = pp.kt_over_kn, b.sqrt_kt_over_kn[k] = pp.sqrt_kt_over_kn;
+            b.cohesion[k] = pp.cohesion;
+          }
         }
       }
+      // A block's results are complete before the next block's grains are set to gravity.
+      flush();
     }
-    flush();
+    max_overlap = std::max(max_overlap, largest);
+    contacts += evaluated;
   }
   s.counters.max_overlap_rel = max_overlap;
   s.counters.contacts = contacts;
@@ -190,7 +239,7 @@ template <class Law>
     WallHit hits[wall_slots_per_particle];
     const int count = wall_hits(model, s.time, s.x[i], s.radius[i], hits, wall_slots_per_particle,
                                 walls ? &s.wall_candidates[q * walls] : nullptr);
-    WallSlot* slots = &s.wall_slots[i * wall_slots_per_particle];
+    WallSlot* slots = &s.wall_slots[q * wall_slots_per_particle];
     WallSlot next[wall_slots_per_particle];
     bool taken[wall_slots_per_particle] = {};
     for (int k = 0; k < count; ++k) {
@@ -278,16 +327,16 @@ void compute_wall_forces(const Model& model, State& state) { dispatch<WallStage>
 
 void sum_forces(State& s, double kick_dt) {
   const NeighbourList& nl = s.neighbours;
-  const PairForces& pf = s.pair_forces;
+  const CrossForces& cf = s.cross_forces;
   const std::size_t n = s.size();
 #pragma omp parallel for schedule(static)
   for (std::size_t j = 0; j < n; ++j) {
     if (!s.active[j]) continue;
     Vec3 f = s.f[j], t = s.torque[j];
-    for (std::int32_t r = nl.reverse_start[j]; r < nl.reverse_start[j + 1]; ++r) {
-      const std::size_t p = std::size_t(nl.reverse_pair[std::size_t(r)]);
-      f += pf.force[p];
-      t += pf.torque[p];
+    for (std::int32_t r = nl.cross_reverse_start[j]; r < nl.cross_reverse_start[j + 1]; ++r) {
+      const std::size_t slot = std::size_t(nl.cross_reverse[std::size_t(r)]);
+      f += cf.force[slot];
+      t += cf.torque[slot];
     }
     s.f[j] = f;
     s.torque[j] = t;

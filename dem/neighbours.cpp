@@ -65,9 +65,35 @@ void permute(std::vector<T>& a, const std::vector<std::int32_t>& order) {
   a.swap(out);
 }
 
-void sort_particles(State& s, const CellGrid& g, std::vector<std::int32_t>& new_index) {
-  // Active particles in cell order, lost ones after them (in their old order).
-  std::vector<std::int32_t> order(g.members);
+// Interleaves the bits of a cell's coordinates (Morton order): consecutive particles then fill
+// compact regions of space, so that a block of them holds most of its grains' neighbours.
+std::uint64_t morton(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+  const auto spread = [](std::uint64_t v) {
+    v &= 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffull;
+    v = (v | v << 16) & 0x1f0000ff0000ffull;
+    v = (v | v << 8) & 0x100f00f00f00f00full;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ull;
+    v = (v | v << 2) & 0x1249249249249249ull;
+    return v;
+  };
+  return spread(x) << 2 | spread(y) << 1 | spread(z);
+}
+
+// Active particles along the Morton curve of their cells (ties in index order), lost ones after
+// them in their old order. new_index: old index -> new.
+std::vector<std::int32_t> sort_particles(State& s, const CellGrid& g, std::vector<std::int32_t>& new_index) {
+  std::vector<std::pair<std::uint64_t, std::int32_t>> keyed;
+  keyed.reserve(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (s.active[i])
+      keyed.push_back({morton(std::uint32_t(g.cell_coord(s.x[i].x(), 0)), std::uint32_t(g.cell_coord(s.x[i].y(), 1)),
+                              std::uint32_t(g.cell_coord(s.x[i].z(), 2))),
+                       std::int32_t(i)});
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<std::int32_t> order;
+  order.reserve(s.size());
+  for (const auto& [key, i] : keyed) order.push_back(i);
   for (std::size_t i = 0; i < s.size(); ++i)
     if (!s.active[i]) order.push_back(std::int32_t(i));
   new_index.assign(s.size(), -1);
@@ -85,18 +111,59 @@ void sort_particles(State& s, const CellGrid& g, std::vector<std::int32_t>& new_
   permute(s.active, order);
   permute(s.body, order);
   for (std::int32_t& i : s.bodies.member) i = new_index[std::size_t(i)];
-  std::vector<WallSlot> slots(s.wall_slots.size());
-  for (std::size_t n = 0; n < order.size(); ++n)
+  return order;
+}
+
+// Wall contact history follows its grains into the new near-wall list (a grain touching a wall
+// is always near it).
+void carry_wall_slots(State& s, const std::vector<std::int32_t>& old_near, std::vector<WallSlot> old_slots,
+                      const std::vector<std::int32_t>& order) {
+  const std::vector<std::int32_t>& near = s.neighbours.near_wall;
+  s.wall_slots.assign(near.size() * wall_slots_per_particle, WallSlot{});
+  for (std::size_t q = 0; q < near.size(); ++q) {
+    const std::int32_t old_i = order[std::size_t(near[q])];
+    const auto at = std::lower_bound(old_near.begin(), old_near.end(), old_i);
+    if (at == old_near.end() || *at != old_i) continue;
+    const std::size_t old_q = std::size_t(at - old_near.begin());
     for (int k = 0; k < wall_slots_per_particle; ++k)
-      slots[n * wall_slots_per_particle + std::size_t(k)] =
-          s.wall_slots[std::size_t(order[n]) * wall_slots_per_particle + std::size_t(k)];
-  s.wall_slots.swap(slots);
+      s.wall_slots[q * wall_slots_per_particle + std::size_t(k)] = old_slots[old_q * wall_slots_per_particle + std::size_t(k)];
+  }
 }
 
 struct OldPair {
   std::int32_t i, j;
-  ContactHistory history;
+  Vec3 tangential, rolling;
 };
+
+// Particles per block (state.hpp, NeighbourList): a function of their number only, so that the
+// sums are the same for any thread count; small enough that two threads get a dozen blocks each
+// for balance, large enough that most pairs lie within one.
+std::int32_t block_size_for(std::size_t n) { return std::int32_t(std::clamp<std::size_t>(n / 32, 256, 4096)); }
+
+// The cross pairs (partner in a later block): each row's buffer slots in pair order, and for each
+// partner the slots naming it, ascending.
+void index_cross_pairs(NeighbourList& nl, std::size_t n) {
+  nl.block_size = block_size_for(n);
+  const std::size_t block = std::size_t(nl.block_size);
+  nl.cross_start.assign(n + 1, 0);
+  nl.cross_reverse_start.assign(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t block_end = std::min(n, (i / block + 1) * block);
+    std::int32_t cross = 0;
+    for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p)
+      if (std::size_t(nl.partner[std::size_t(p)]) >= block_end) ++cross, ++nl.cross_reverse_start[std::size_t(nl.partner[std::size_t(p)]) + 1];
+    nl.cross_start[i + 1] = nl.cross_start[i] + cross;
+  }
+  for (std::size_t i = 0; i < n; ++i) nl.cross_reverse_start[i + 1] += nl.cross_reverse_start[i];
+  nl.cross_reverse.resize(std::size_t(nl.cross_start[n]));
+  std::vector<std::int32_t> fill(nl.cross_reverse_start.begin(), nl.cross_reverse_start.end() - 1);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t block_end = std::min(n, (i / block + 1) * block);
+    std::int32_t slot = nl.cross_start[i];
+    for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p)
+      if (const std::size_t j = std::size_t(nl.partner[std::size_t(p)]); j >= block_end) nl.cross_reverse[std::size_t(fill[j]++)] = slot++;
+  }
+}
 
 }  // namespace
 
@@ -137,16 +204,21 @@ void rebuild_neighbours(const Model& model, State& s) {
 
   // Old pairs with their history, by particle index before sorting.
   NeighbourList& nl = s.neighbours;
+  const bool tangential = model.tangential != TangentialLaw::none, rolling = model.rolling == RollingLaw::epsd;
   std::vector<OldPair> old;
-  old.reserve(nl.partner.size());
+  old.reserve(nl.partner.size() / 2);
   for (std::size_t i = 0; i + 1 < nl.row_start.size(); ++i)
-    for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p)
-      if (nl.history[std::size_t(p)].tangential.squaredNorm() > 0 || nl.history[std::size_t(p)].rolling.squaredNorm() > 0)
-        old.push_back({std::int32_t(i), nl.partner[std::size_t(p)], nl.history[std::size_t(p)]});
+    for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p) {
+      const Vec3 t = nl.tangential.empty() ? Vec3::Zero() : nl.tangential[std::size_t(p)];
+      const Vec3 r = nl.rolling.empty() ? Vec3::Zero() : nl.rolling[std::size_t(p)];
+      if (t.squaredNorm() > 0 || r.squaredNorm() > 0) old.push_back({std::int32_t(i), nl.partner[std::size_t(p)], t, r});
+    }
+  const std::vector<std::int32_t> old_near = nl.near_wall;
+  std::vector<WallSlot> old_slots = std::move(s.wall_slots);
 
   CellGrid grid = make_grid(model, s);
   std::vector<std::int32_t> new_index;
-  sort_particles(s, grid, new_index);
+  const std::vector<std::int32_t> order = sort_particles(s, grid, new_index);
   grid = make_grid(model, s);  // members now ascending along the cells
   // Re-key old pairs to the new indices, smaller index first (history is i's view: negate).
   for (OldPair& o : old) {
@@ -154,8 +226,8 @@ void rebuild_neighbours(const Model& model, State& s) {
     o.j = new_index[std::size_t(o.j)];
     if (o.i > o.j) {
       std::swap(o.i, o.j);
-      o.history.tangential = -o.history.tangential;
-      o.history.rolling = -o.history.rolling;
+      o.tangential = -o.tangential;
+      o.rolling = -o.rolling;
     }
   }
   std::sort(old.begin(), old.end(), [](const OldPair& a, const OldPair& b) {
@@ -199,7 +271,8 @@ void rebuild_neighbours(const Model& model, State& s) {
   for (std::size_t i = 0; i < n; ++i) nl.row_start[i + 1] = nl.row_start[i] + std::int32_t(rows[i].size());
   const std::size_t pairs = std::size_t(nl.row_start[n]);
   nl.partner.resize(pairs);
-  nl.history.assign(pairs, ContactHistory{});
+  nl.tangential.assign(tangential ? pairs : 0, Vec3::Zero());
+  nl.rolling.assign(rolling ? pairs : 0, Vec3::Zero());
   nl.touching.assign(pairs, 0);
   std::size_t cursor = 0;  // into `old`, sorted by row and partner: row i's old pairs are [cursor, row_end)
   for (std::size_t i = 0; i < n; ++i) {
@@ -212,28 +285,24 @@ void rebuild_neighbours(const Model& model, State& s) {
       const auto found = std::lower_bound(old.begin() + std::ptrdiff_t(cursor), old.begin() + std::ptrdiff_t(row_end), j,
                                           [](const OldPair& o, std::int32_t partner) { return o.j < partner; });
       if (found != old.begin() + std::ptrdiff_t(row_end) && found->j == j) {
-        nl.history[p] = found->history;
+        if (tangential) nl.tangential[p] = found->tangential;
+        if (rolling) nl.rolling[p] = found->rolling;
         nl.touching[p] = 1;
       }
       ++p;
     }
     cursor = row_end;
   }
-  // Reverse index: for each j, the pairs naming it, ascending.
-  nl.reverse_start.assign(n + 1, 0);
-  for (std::int32_t j : nl.partner) ++nl.reverse_start[std::size_t(j) + 1];
-  for (std::size_t i = 0; i < n; ++i) nl.reverse_start[i + 1] += nl.reverse_start[i];
-  nl.reverse_pair.resize(pairs);
-  std::vector<std::int32_t> fill(nl.reverse_start.begin(), nl.reverse_start.end() - 1);
-  for (std::size_t p = 0; p < pairs; ++p) nl.reverse_pair[std::size_t(fill[std::size_t(nl.partner[p])]++)] = std::int32_t(p);
+  index_cross_pairs(nl, n);
+  s.cross_forces.force.assign(nl.cross_reverse.size(), Vec3::Zero());
+  s.cross_forces.torque.assign(nl.cross_reverse.size(), Vec3::Zero());
 
   nl.x_at_build = s.x;
   nl.time_at_build = s.time;
   nl.wall_shift_at_build.resize(model.meshes.size());
   for (std::size_t m = 0; m < model.meshes.size(); ++m) nl.wall_shift_at_build[m] = model.meshes[m].motion.position(s.time);
   collect_near_wall(model, s);
-  s.pair_forces.force.assign(pairs, Vec3::Zero());
-  s.pair_forces.torque.assign(pairs, Vec3::Zero());
+  carry_wall_slots(s, old_near, std::move(old_slots), order);
   ++nl.builds;
 }
 

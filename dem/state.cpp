@@ -19,7 +19,19 @@ void State::add_sphere(std::int64_t particle_id, const Vec3& position, double r,
   material.push_back(material_index);
   active.push_back(1);
   body.push_back(-1);
-  wall_slots.resize(wall_slots.size() + wall_slots_per_particle);
+}
+
+std::size_t State::memory_bytes() const {
+  std::size_t total = 0;
+  const auto add = [&total](const auto&... arrays) { ((total += arrays.capacity() * sizeof(arrays[0])), ...); };
+  add(id, x, v, w, f, torque, radius, mass, inertia, material, active, body, wall_slots, scratch_wall_power, wall_candidates);
+  add(bodies.x, bodies.v, bodies.q, bodies.l, bodies.f, bodies.torque, bodies.mass, bodies.inertia, bodies.volume,
+      bodies.active, bodies.member_start, bodies.member, bodies.offset);
+  const NeighbourList& nl = neighbours;
+  add(nl.row_start, nl.partner, nl.tangential, nl.rolling, nl.touching, nl.cross_start, nl.cross_reverse_start,
+      nl.cross_reverse, nl.near_wall, nl.x_at_build, nl.wall_shift_at_build);
+  add(cross_forces.force, cross_forces.torque);
+  return total;
 }
 
 }  // namespace dem

@@ -30,25 +30,37 @@ struct WallCandidates {
   std::int32_t triangles[8];
 };
 
+// The half neighbour list (j > i) in compressed rows, with each pair's contact history beside
+// it. Particles are sorted along a space-filling curve at every build and split into blocks of
+// consecutive particles (block_size, a function of N only): a pair within a block adds its
+// partner's share to the partner directly, in row order; a pair reaching into a later block
+// ("cross" pair) writes the share to a buffer, summed per partner afterwards in pair order. Every
+// grain's force is therefore summed in one fixed order, whatever the thread count, and only the
+// cross pairs need buffers (docs/ARCHITECTURE.md, "Model and state").
 struct NeighbourList {
   std::vector<std::int32_t> row_start;      // [N+1] pairs of particle i: [row_start[i], row_start[i+1])
   std::vector<std::int32_t> partner;        // [P] j > i
-  std::vector<ContactHistory> history;      // [P]
+  std::vector<Vec3> tangential;             // [P] Mindlin spring ξ [m]; empty without tangential friction
+  std::vector<Vec3> rolling;                // [P] EPSD torque [N m]; empty unless the rolling law is EPSD
   std::vector<std::uint8_t> touching;       // [P] 1 while the pair is in contact
-  std::vector<std::int32_t> reverse_start;  // [N+1] pairs where particle j is the partner
-  std::vector<std::int32_t> reverse_pair;   // [P] pair indices, ascending
+  std::int32_t block_size = 1;              // particles per block
+  std::vector<std::int32_t> cross_start;    // [N+1] cross pairs of row i: buffer slots [cross_start[i], cross_start[i+1])
+  std::vector<std::int32_t> cross_reverse_start;  // [N+1] cross slots naming particle j as partner
+  std::vector<std::int32_t> cross_reverse;  // [C] those slots, ascending
   std::vector<std::int32_t> near_wall;      // particles within range of a wall at build time
   std::vector<Vec3> x_at_build;             // [N] [m]
   std::vector<Vec3> wall_shift_at_build;    // [mesh walls] [m] wall origin at build time
   double time_at_build = 0;                 // [s]
   std::int64_t builds = 0;
+
+  std::size_t blocks() const { return (row_start.size() - 1 + std::size_t(block_size) - 1) / std::size_t(block_size); }
 };
 
-// The partner's share of each pair's force, written by the row owner and summed per partner
-// afterwards in a fixed order (the owner adds its own share directly).
-struct PairForces {
-  std::vector<Vec3> force;   // [P] on j [N]
-  std::vector<Vec3> torque;  // [P] on j [N m]
+// The partner's share of each cross pair's force, written by the row owner and summed per
+// partner afterwards in a fixed order.
+struct CrossForces {
+  std::vector<Vec3> force;   // [C] on j [N]
+  std::vector<Vec3> torque;  // [C] on j [N m]
 };
 
 // Rigid multi-sphere clumps. Members are ordinary particles, so that contacts between clumps,
@@ -102,12 +114,12 @@ struct State {
   std::vector<std::int32_t> material;
   std::vector<std::uint8_t> active;  // 0: lost (left the domain), no longer simulated
   std::vector<std::int32_t> body;    // index into `bodies`; -1: a free sphere
-  std::vector<WallSlot> wall_slots;  // [N*K]
+  std::vector<WallSlot> wall_slots;  // [near-wall grains x K], in the order of neighbours.near_wall
 
   Bodies bodies;
 
   NeighbourList neighbours;
-  PairForces pair_forces;
+  CrossForces cross_forces;
   StepCounters counters;
   std::vector<double> scratch_wall_power;  // [near-wall grains], summed serially
   std::vector<WallCandidates> wall_candidates;  // [near-wall grains x mesh walls], see walls.hpp
@@ -121,6 +133,8 @@ struct State {
   bool energy_reference_set = false;
 
   std::size_t size() const { return x.size(); }
+  // Every array's allocation [bytes], for the benchmarks' bytes per particle.
+  std::size_t memory_bytes() const;
   // Appends a sphere; density in kg/m³.
   void add_sphere(std::int64_t particle_id, const Vec3& position, double r, double density,
                   int material_index, const Vec3& velocity = Vec3::Zero(),

@@ -151,7 +151,6 @@ double potential_energy(const Model& model, const State& s) {
 void initialize(const Model& model, State& s) {
   s.f.resize(s.size(), Vec3::Zero());
   s.torque.resize(s.size(), Vec3::Zero());
-  s.wall_slots.resize(s.size() * wall_slots_per_particle);
   rebuild_neighbours(model, s);
   forces(model, s, nullptr, 0);
   s.energy_reference = kinetic_energy(s) + potential_energy(model, s) + elastic_energy(model, s);
@@ -188,7 +187,8 @@ std::string state_hash(const State& s) {
   put(s.v);
   put(s.w);
   put(s.active);
-  put(s.neighbours.history);
+  put(s.neighbours.tangential);
+  put(s.neighbours.rolling);
   // Bodies only where there are any, so that a sphere scene hashes as it always did.
   if (s.bodies.size() > 0) {
     put(s.body);

@@ -3,7 +3,9 @@
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <numbers>
 
 #include "core/log.hpp"
 #include "core/sha256.hpp"
@@ -36,22 +38,26 @@ struct Insertion {
   std::optional<mesh::ClumpTemplate> clump;
 };
 
-// The box above the powder already in the shoe (from the table at first), inside its walls.
-dem::InsertRegion space_above_bed(const Insertion& in, const dem::State& bed) {
+// The box above the powder already in the shoe (from the table at first), inside its walls, as
+// high as `count` more grains need at the jamming fraction of random insertion (about 0.38 of
+// the poured 0.6): grains dropped from no higher than that cannot be thrown out of the shoe.
+dem::InsertRegion space_above_bed(const Insertion& in, const dem::State& bed, std::size_t count) {
   const double inset = in.grains.r_max + 1e-6;
   double floor = in.table_z;
   for (std::size_t i = 0; i < bed.size(); ++i) floor = std::max(floor, bed.x[i].z() + bed.radius[i]);
-  const double first_round_top = in.table_z + in.scene.fill_height * 0.6 / 0.38 + 2 * in.grains.r_max;
-  const double top = in.table_z + in.scene.shoe_height - inset;
+  const double bed_height = bed.size() == 0 ? in.scene.fill_height
+                                            : double(count) * std::numbers::pi / 6 * std::pow(in.grains.diameter, 3) /
+                                                  (0.6 * in.shoe.length * in.shoe.width);
+  const double top = std::min(in.table_z + in.scene.shoe_height - inset,
+                              (bed.size() == 0 ? in.table_z : floor) + bed_height * 0.6 / 0.38 + 2 * in.grains.r_max);
   dem::InsertRegion region;
   region.box = {Vec3(in.shoe.x_start - 0.5 * in.shoe.length + inset, in.shoe.y_centre - 0.5 * in.shoe.width + inset, floor + inset),
-                Vec3(in.shoe.x_start + 0.5 * in.shoe.length - inset, in.shoe.y_centre + 0.5 * in.shoe.width - inset,
-                     bed.size() == 0 ? std::min(top, first_round_top) : top)};
+                Vec3(in.shoe.x_start + 0.5 * in.shoe.length - inset, in.shoe.y_centre + 0.5 * in.shoe.width - inset, top)};
   return region;
 }
 
 std::size_t insert_round(const Insertion& in, dem::State& bed, std::size_t count, int round) {
-  const dem::InsertRegion region = space_above_bed(in, bed);
+  const dem::InsertRegion region = space_above_bed(in, bed, count);
   if (region.box.hi.z() <= region.box.lo.z()) return 0;
   const std::uint64_t seed = in.scene.seed + std::uint64_t(round) * 7919;  // round 0: the scene's seed, as always
   const std::int64_t first_id = bed.size() == 0 ? 0 : *std::max_element(bed.id.begin(), bed.id.end()) + 1;
