@@ -15,8 +15,8 @@ struct Writer {
   std::string bytes;
   template <typename T>
   void value(const T& v) { bytes.append(reinterpret_cast<const char*>(&v), sizeof v); }
-  template <typename T>
-  void array(const std::vector<T>& v) {
+  template <typename T, typename A>
+  void array(const std::vector<T, A>& v) {
     value(std::uint64_t(v.size()));
     bytes.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
   }
@@ -26,8 +26,8 @@ struct Reader {
   std::ifstream in;
   template <typename T>
   void value(T& v) { in.read(reinterpret_cast<char*>(&v), sizeof v); }
-  template <typename T>
-  void array(std::vector<T>& v) {
+  template <typename T, typename A>
+  void array(std::vector<T, A>& v) {
     std::uint64_t n = 0;
     value(n);
     if (!in || n > (std::uint64_t(1) << 40) / sizeof(T)) {

@@ -144,6 +144,8 @@ void pair_forces(const Model& model, State& s) {
   const double* const mass = s.mass.data();
   const std::int32_t* const partner = nl.partner.data();
   std::uint8_t* const touching = nl.touching.data();
+  const std::int32_t pairs_end = std::int32_t(nl.partner.size());
+  constexpr std::int32_t prefetch_distance = 6;
 #pragma omp parallel reduction(max : max_overlap) reduction(+ : contacts)
   {
     static thread_local ContactBatch batch;
@@ -176,6 +178,15 @@ void pair_forces(const Model& model, State& s) {
         const std::int32_t row_end = nl.row_start[i + 1];
         for (std::int32_t p = nl.row_start[i]; p < row_end; ++p) {
           const std::size_t j = std::size_t(partner[p]);
+          // The partner a few pairs ahead is fetched while this one is computed: the loop waits on
+          // its partners' data, not on arithmetic, once the grains outgrow the first-level cache.
+          if (p + prefetch_distance < pairs_end) {
+            const std::size_t ahead = std::size_t(partner[p + prefetch_distance]);
+            __builtin_prefetch(&x[ahead]);
+            __builtin_prefetch(&v[ahead]);
+            __builtin_prefetch(&w[ahead]);
+            __builtin_prefetch(&radius[ahead]);
+          }
           const std::int32_t slot = j < hi ? -1 : cross_slot++;
           const Vec3 d = xi - x[j];
           const double reach = ri + radius[j];
@@ -224,11 +235,11 @@ void pair_forces(const Model& model, State& s) {
 
 template <class Law>
 [[gnu::flatten]] void wall_forces(const Model& model, State& s) {
-  const std::vector<std::int32_t>& near = s.neighbours.near_wall;
+  const Array<std::int32_t>& near = s.neighbours.near_wall;
   const double dt = model.dt;
   double max_overlap = s.counters.max_overlap_rel;
   std::int64_t contacts = 0;
-  std::vector<double>& power = s.scratch_wall_power;
+  Array<double>& power = s.scratch_wall_power;
   power.assign(near.size(), 0.0);
   const std::size_t walls = model.meshes.size();
   if (s.wall_candidates.size() != near.size() * walls) s.wall_candidates.assign(near.size() * walls, WallCandidates{});

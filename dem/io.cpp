@@ -135,7 +135,7 @@ void write_vtu(const State& s, const fs::path& path) {
   std::string out;
   out += "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n";
   out += fmt::format("<UnstructuredGrid><Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n", s.size(), s.size());
-  auto vectors = [&](const char* name, const std::vector<Vec3>& a) {
+  auto vectors = [&](const char* name, const Array<Vec3>& a) {
     out += fmt::format("<DataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"3\" format=\"ascii\">\n", name);
     for (const Vec3& v : a) out += fmt::format("{:.9g} {:.9g} {:.9g}\n", v.x(), v.y(), v.z());
     out += "</DataArray>\n";

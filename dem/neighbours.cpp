@@ -58,9 +58,9 @@ CellGrid make_grid(const Model& model, const State& s) {
 }
 
 // Applies `order` (new index -> old index) to every per-particle array.
-template <typename T>
-void permute(std::vector<T>& a, const std::vector<std::int32_t>& order) {
-  std::vector<T> out(order.size());
+template <typename Values>
+void permute(Values& a, const std::vector<std::int32_t>& order) {
+  Values out(order.size());
   for (std::size_t n = 0; n < order.size(); ++n) out[n] = a[std::size_t(order[n])];
   a.swap(out);
 }
@@ -116,9 +116,9 @@ std::vector<std::int32_t> sort_particles(State& s, const CellGrid& g, std::vecto
 
 // Wall contact history follows its grains into the new near-wall list (a grain touching a wall
 // is always near it).
-void carry_wall_slots(State& s, const std::vector<std::int32_t>& old_near, std::vector<WallSlot> old_slots,
+void carry_wall_slots(State& s, const Array<std::int32_t>& old_near, const Array<WallSlot>& old_slots,
                       const std::vector<std::int32_t>& order) {
-  const std::vector<std::int32_t>& near = s.neighbours.near_wall;
+  const Array<std::int32_t>& near = s.neighbours.near_wall;
   s.wall_slots.assign(near.size() * wall_slots_per_particle, WallSlot{});
   for (std::size_t q = 0; q < near.size(); ++q) {
     const std::int32_t old_i = order[std::size_t(near[q])];
@@ -213,8 +213,8 @@ void rebuild_neighbours(const Model& model, State& s) {
       const Vec3 r = nl.rolling.empty() ? Vec3::Zero() : nl.rolling[std::size_t(p)];
       if (t.squaredNorm() > 0 || r.squaredNorm() > 0) old.push_back({std::int32_t(i), nl.partner[std::size_t(p)], t, r});
     }
-  const std::vector<std::int32_t> old_near = nl.near_wall;
-  std::vector<WallSlot> old_slots = std::move(s.wall_slots);
+  const Array<std::int32_t> old_near = nl.near_wall;
+  const Array<WallSlot> old_slots = std::move(s.wall_slots);
 
   CellGrid grid = make_grid(model, s);
   std::vector<std::int32_t> new_index;
@@ -302,7 +302,7 @@ void rebuild_neighbours(const Model& model, State& s) {
   nl.wall_shift_at_build.resize(model.meshes.size());
   for (std::size_t m = 0; m < model.meshes.size(); ++m) nl.wall_shift_at_build[m] = model.meshes[m].motion.position(s.time);
   collect_near_wall(model, s);
-  carry_wall_slots(s, old_near, std::move(old_slots), order);
+  carry_wall_slots(s, old_near, old_slots, order);
   ++nl.builds;
 }
 

@@ -38,18 +38,18 @@ struct WallCandidates {
 // grain's force is therefore summed in one fixed order, whatever the thread count, and only the
 // cross pairs need buffers (docs/ARCHITECTURE.md, "Model and state").
 struct NeighbourList {
-  std::vector<std::int32_t> row_start;      // [N+1] pairs of particle i: [row_start[i], row_start[i+1])
-  std::vector<std::int32_t> partner;        // [P] j > i
-  std::vector<Vec3> tangential;             // [P] Mindlin spring ξ [m]; empty without tangential friction
-  std::vector<Vec3> rolling;                // [P] EPSD torque [N m]; empty unless the rolling law is EPSD
-  std::vector<std::uint8_t> touching;       // [P] 1 while the pair is in contact
+  Array<std::int32_t> row_start;      // [N+1] pairs of particle i: [row_start[i], row_start[i+1])
+  Array<std::int32_t> partner;        // [P] j > i
+  Array<Vec3> tangential;             // [P] Mindlin spring ξ [m]; empty without tangential friction
+  Array<Vec3> rolling;                // [P] EPSD torque [N m]; empty unless the rolling law is EPSD
+  Array<std::uint8_t> touching;       // [P] 1 while the pair is in contact
   std::int32_t block_size = 1;              // particles per block
-  std::vector<std::int32_t> cross_start;    // [N+1] cross pairs of row i: buffer slots [cross_start[i], cross_start[i+1])
-  std::vector<std::int32_t> cross_reverse_start;  // [N+1] cross slots naming particle j as partner
-  std::vector<std::int32_t> cross_reverse;  // [C] those slots, ascending
-  std::vector<std::int32_t> near_wall;      // particles within range of a wall at build time
-  std::vector<Vec3> x_at_build;             // [N] [m]
-  std::vector<Vec3> wall_shift_at_build;    // [mesh walls] [m] wall origin at build time
+  Array<std::int32_t> cross_start;    // [N+1] cross pairs of row i: buffer slots [cross_start[i], cross_start[i+1])
+  Array<std::int32_t> cross_reverse_start;  // [N+1] cross slots naming particle j as partner
+  Array<std::int32_t> cross_reverse;  // [C] those slots, ascending
+  Array<std::int32_t> near_wall;      // particles within range of a wall at build time
+  Array<Vec3> x_at_build;             // [N] [m]
+  Array<Vec3> wall_shift_at_build;    // [mesh walls] [m] wall origin at build time
   double time_at_build = 0;                 // [s]
   std::int64_t builds = 0;
 
@@ -59,8 +59,8 @@ struct NeighbourList {
 // The partner's share of each cross pair's force, written by the row owner and summed per
 // partner afterwards in a fixed order.
 struct CrossForces {
-  std::vector<Vec3> force;   // [C] on j [N]
-  std::vector<Vec3> torque;  // [C] on j [N m]
+  Array<Vec3> force;   // [C] on j [N]
+  Array<Vec3> torque;  // [C] on j [N m]
 };
 
 // Rigid multi-sphere clumps. Members are ordinary particles, so that contacts between clumps,
@@ -71,19 +71,19 @@ struct CrossForces {
 // the same bits for any thread count. Angular momentum is kept in the world frame, where a free
 // body's stays constant exactly; mass and inertia are the grain's, not the spheres'.
 struct Bodies {
-  std::vector<Vec3> x;              // [B] centre of mass [m]
-  std::vector<Vec3> v;              // [B] [m/s]
-  std::vector<Quat> q;              // [B] unit, principal frame to world
-  std::vector<Vec3> l;              // [B] angular momentum about the centre, world frame [kg m²/s]
-  std::vector<Vec3> f;              // [B] [N], gravity included
-  std::vector<Vec3> torque;         // [B] about the centre, world frame [N m]
-  std::vector<double> mass;         // [B] [kg]
-  std::vector<Vec3> inertia;        // [B] principal moments, ascending [kg m²]
-  std::vector<double> volume;       // [B] of the grain (not of the spheres' union) [m³]
-  std::vector<std::uint8_t> active; // [B] 0: lost with its members
-  std::vector<std::int32_t> member_start;  // [B+1] members of b: [member_start[b], member_start[b+1])
-  std::vector<std::int32_t> member;        // [M] particle index
-  std::vector<Vec3> offset;                // [M] member centre in the principal frame [m]
+  Array<Vec3> x;              // [B] centre of mass [m]
+  Array<Vec3> v;              // [B] [m/s]
+  Array<Quat> q;              // [B] unit, principal frame to world
+  Array<Vec3> l;              // [B] angular momentum about the centre, world frame [kg m²/s]
+  Array<Vec3> f;              // [B] [N], gravity included
+  Array<Vec3> torque;         // [B] about the centre, world frame [N m]
+  Array<double> mass;         // [B] [kg]
+  Array<Vec3> inertia;        // [B] principal moments, ascending [kg m²]
+  Array<double> volume;       // [B] of the grain (not of the spheres' union) [m³]
+  Array<std::uint8_t> active; // [B] 0: lost with its members
+  Array<std::int32_t> member_start;  // [B+1] members of b: [member_start[b], member_start[b+1])
+  Array<std::int32_t> member;        // [M] particle index
+  Array<Vec3> offset;                // [M] member centre in the principal frame [m]
 
   std::size_t size() const { return x.size(); }
   // World angular velocity ω = R I⁻¹ Rᵀ L [rad/s].
@@ -102,27 +102,27 @@ struct StepCounters {
 
 struct State {
   // Particles [N]
-  std::vector<std::int64_t> id;
-  std::vector<Vec3> x;          // position [m]
-  std::vector<Vec3> v;          // velocity [m/s]
-  std::vector<Vec3> w;          // angular velocity [rad/s]
-  std::vector<Vec3> f;          // force [N]
-  std::vector<Vec3> torque;     // [N m]
-  std::vector<double> radius;   // [m]
-  std::vector<double> mass;     // [kg]; a clump member's is its body's, for the contact laws
-  std::vector<double> inertia;  // [kg m²] (solid sphere: 2/5 m r²); unused for clump members
-  std::vector<std::int32_t> material;
-  std::vector<std::uint8_t> active;  // 0: lost (left the domain), no longer simulated
-  std::vector<std::int32_t> body;    // index into `bodies`; -1: a free sphere
-  std::vector<WallSlot> wall_slots;  // [near-wall grains x K], in the order of neighbours.near_wall
+  Array<std::int64_t> id;
+  Array<Vec3> x;          // position [m]
+  Array<Vec3> v;          // velocity [m/s]
+  Array<Vec3> w;          // angular velocity [rad/s]
+  Array<Vec3> f;          // force [N]
+  Array<Vec3> torque;     // [N m]
+  Array<double> radius;   // [m]
+  Array<double> mass;     // [kg]; a clump member's is its body's, for the contact laws
+  Array<double> inertia;  // [kg m²] (solid sphere: 2/5 m r²); unused for clump members
+  Array<std::int32_t> material;
+  Array<std::uint8_t> active;  // 0: lost (left the domain), no longer simulated
+  Array<std::int32_t> body;    // index into `bodies`; -1: a free sphere
+  Array<WallSlot> wall_slots;  // [near-wall grains x K], in the order of neighbours.near_wall
 
   Bodies bodies;
 
   NeighbourList neighbours;
   CrossForces cross_forces;
   StepCounters counters;
-  std::vector<double> scratch_wall_power;  // [near-wall grains], summed serially
-  std::vector<WallCandidates> wall_candidates;  // [near-wall grains x mesh walls], see walls.hpp
+  Array<double> scratch_wall_power;  // [near-wall grains], summed serially
+  Array<WallCandidates> wall_candidates;  // [near-wall grains x mesh walls], see walls.hpp
 
   double time = 0;              // [s]
   std::int64_t step = 0;

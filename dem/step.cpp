@@ -22,7 +22,7 @@ double kick_and_drift(State& s, double half_dt, double dt) {
   kick_bodies(s, half_dt);
   drift_bodies(s, dt);
   const std::size_t n = s.size();
-  const std::vector<Vec3>& built = s.neighbours.x_at_build;
+  const Array<Vec3>& built = s.neighbours.x_at_build;
   const bool listed = built.size() == n;
   double largest = 0;
 #pragma omp parallel for schedule(static) reduction(max : largest)

@@ -55,7 +55,7 @@ double wall_distance(const Model& model, double time, const Vec3& x) {
 }
 
 void collect_near_wall(const Model& model, State& s) {
-  std::vector<std::int32_t>& near = s.neighbours.near_wall;
+  Array<std::int32_t>& near = s.neighbours.near_wall;
   near.clear();
   for (std::size_t i = 0; i < s.size(); ++i) {
     if (!s.active[i]) continue;

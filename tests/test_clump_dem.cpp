@@ -242,7 +242,7 @@ TEST(ClumpRigidity, OverlappingMembersExertNoForceOnEachOther) {
   dem::State s = one_clump(cross(), Quat(0.6, -0.2, 0.7, 0.3).normalized(), Vec3(1e-3, 2e-3, -1e-3), Vec3::Zero());
   const dem::Model model = dem::compile_model(free_space(1e-6), s, "rigid clump");
   dem::initialize(model, s);
-  const std::vector<Vec3> x0 = s.x;
+  const dem::Array<Vec3> x0 = s.x;
   const Vec3 centre = s.bodies.x[0];
   for (int n = 0; n < 1000; ++n) dem::step(model, s);
   EXPECT_TRUE(s.neighbours.partner.empty()) << "no pair of one clump is listed";
