@@ -10,27 +10,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 size="${1:-5k}"; repeats="${2:-5}"; steps="${3:-15000}"
-ref="${DIEFILL_LIGGGHTS_DIR:-$root/../shared/bench/liggghts}"
-work="${DIEFILL_BENCH_WORK:-$root/out/bench/liggghts}"
-for p in liggghts openscad mpirun; do
-  command -v "$p" >/dev/null || { DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends liggghts openscad openmpi-bin >/dev/null; }
-done
-"$root/scripts/setup.sh" diefill >&2
-mkdir -p "$work"
-cp -r "$ref/in" "$ref/scad" "$ref/make_stl.sh" "$work/"
-cd "$work"
-[[ -f stl/n50k_plain128.stl ]] || bash make_stl.sh >/dev/null 2>&1
-case "$size" in
-  5k) R=0.010; H=0.040; N=5000; insH=0.033; tag=n5k_plain128 ;;
-  50k) R=0.022; H=0.070; N=50000; insH=0.065; tag=n50k_plain128 ;;
-  *) echo "size must be 5k or 50k" >&2; exit 2 ;;
-esac
-mkdir -p runs
-if [[ ! -f runs/$tag.packed.dump ]]; then
-  echo "preparing the settled pack with LIGGGHTS ($N grains, once)..." >&2
-  liggghts -in in/prep.in -var wallfile in/wall_mesh.in -var stl stl/$tag.stl -var R $R -var H $H -var N $N \
-    -var insH $insH -var prepdt 5e-6 -var tag $tag -var maxsteps 200000 > prep_$tag.log
-fi
+source "$root/bench/liggghts_pack.sh"
 mpi=(mpirun --allow-run-as-root --oversubscribe -np 2)
 liggghts_rate() {  # ranks...
   local loop

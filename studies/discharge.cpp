@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include "pipeline/die_fill.hpp"
 #include "studies/studies.hpp"
@@ -21,6 +22,9 @@ namespace app::study {
 namespace {
 
 using dem::Vec3;
+
+// The slot form's coefficient, C_s = 1.03 (Myers & Sellers, quoted by Nedderman 1992, ch. 10).
+constexpr double published_slot_c = 1.03;
 
 struct DischargeSizes {
   std::vector<double> slot_widths;  // [grain diameters]
@@ -48,10 +52,14 @@ struct BeverlooFit {
   double rate(double length, double width, double d) const { return a * beverloo_slot(length, width, k, d); }
 };
 
-BeverlooFit fit_beverloo(const std::vector<double>& width, const std::vector<double>& rate, double length, double d) {
+// With `fixed_a`, only k is fitted: the law with a published coefficient, whose k is then pinned
+// far more tightly than when C_s and k, strongly correlated, are both free.
+BeverlooFit fit_beverloo(const std::vector<double>& width, const std::vector<double>& rate, double length, double d,
+                         std::optional<double> fixed_a = std::nullopt) {
   const std::size_t n = width.size();
   const auto shape = [&](double k, std::size_t i) { return beverloo_slot(length, width[i], k, d); };
   const auto best_a = [&](double k) {
+    if (fixed_a) return *fixed_a;
     double fw = 0, ff = 0;
     for (std::size_t i = 0; i < n; ++i) fw += shape(k, i) * rate[i], ff += shape(k, i) * shape(k, i);
     return fw / ff;
@@ -72,7 +80,8 @@ BeverlooFit fit_beverloo(const std::vector<double>& width, const std::vector<dou
   double rel = 0;
   for (std::size_t i = 0; i < n; ++i) rel += std::pow(rate[i] / (fit.a * shape(fit.k, i)) - 1, 2);
   fit.rms_relative_residual = std::sqrt(rel / double(n));
-  if (n > 2) {
+  const std::size_t parameters = fixed_a ? 1 : 2;
+  if (n > parameters) {
     // Standard errors from the linearised model: covariance sigma² (JᵀJ)⁻¹.
     double jaa = 0, jak = 0, jkk = 0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -81,9 +90,9 @@ BeverlooFit fit_beverloo(const std::vector<double>& width, const std::vector<dou
                                  1.5 * d * (length - fit.k * d) * std::sqrt(width[i] - fit.k * d));
       jaa += ja * ja, jak += ja * jk, jkk += jk * jk;
     }
-    const double sigma2 = best / double(n - 2), det = jaa * jkk - jak * jak;
-    fit.a_error = std::sqrt(sigma2 * jkk / det);
-    fit.k_error = std::sqrt(sigma2 * jaa / det);
+    const double sigma2 = best / double(n - parameters), det = jaa * jkk - jak * jak;
+    fit.a_error = fixed_a ? 0.0 : std::sqrt(sigma2 * jkk / det);
+    fit.k_error = fixed_a ? std::sqrt(sigma2 / jkk) : std::sqrt(sigma2 * jaa / det);
   }
   return fit;
 }
@@ -142,8 +151,12 @@ void discharge(const PipelineScene& scene, bool reduced, Output& out) {
   const BeverlooFit fit = fit_beverloo(widths, rates, slot_length, d);
   const double scale = bulk_density * std::sqrt(g);
   const double c_s = fit.a / scale, c_s_error = fit.a_error / scale;
-  diefill::log::info("discharge: Beverloo slot law C_s = {:.3f} ± {:.3f}, k = {:.2f} ± {:.2f} (bulk density {:.0f} kg/m³)", c_s,
-                     c_s_error, fit.k, fit.k_error, bulk_density);
+  // The slot law's published coefficient (docs/PHYSICS.md §3): the k it needs, and how well it fits.
+  const BeverlooFit published = fit_beverloo(widths, rates, slot_length, d, published_slot_c * scale);
+  diefill::log::info("discharge: Beverloo slot law C_s = {:.3f} ± {:.3f}, k = {:.2f} ± {:.2f} (bulk density {:.0f} kg/m³); "
+                     "with the published C_s = {:.2f}, k = {:.2f} ± {:.2f} (residual {:.1f} %)",
+                     c_s, c_s_error, fit.k, fit.k_error, bulk_density, published_slot_c, published.k, published.k_error,
+                     100 * published.rms_relative_residual);
 
   Chart flow{"beverloo.png", "Slot discharge against the Beverloo slot law", "slot width b [mm]", "mass flow rate [g/s]"};
   Series measured{"DEM", {}, {}, {}, "points"};
@@ -226,7 +239,9 @@ void discharge(const PipelineScene& scene, bool reduced, Output& out) {
         {"rate_errors_kg_s", errors},
         {"bulk_density_kg_m3", bulk_density},
         {"beverloo", {{"C_s", c_s}, {"C_s_error", c_s_error}, {"k", fit.k}, {"k_error", fit.k_error},
-                      {"rms_relative_residual", fit.rms_relative_residual}}}}},
+                      {"rms_relative_residual", fit.rms_relative_residual}}},
+        {"beverloo_published_C_s", {{"C_s", published_slot_c}, {"k", published.k}, {"k_error", published.k_error},
+                                    {"rms_relative_residual", published.rms_relative_residual}}}}},
       {"moving_shoe",
        {{"opening_m", {opening, opening}},
         {"depth_m", depth},

@@ -68,6 +68,17 @@ void forget_wall_contacts(dem::State& state) {
   for (dem::WallSlot& slot : state.wall_slots) slot = dem::WallSlot{};
 }
 
+MeanAndError mean_and_error(const std::vector<double>& x) {
+  MeanAndError m;
+  const double n = double(x.size());
+  for (double v : x) m.mean += v / n;
+  if (x.size() < 2) return m;
+  double ss = 0;
+  for (double v : x) ss += (v - m.mean) * (v - m.mean);
+  m.error = std::sqrt(ss / (n - 1) / n);
+  return m;
+}
+
 LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y) {
   LineFit fit;
   fit.points = x.size();

@@ -70,6 +70,12 @@ struct LineFit {
 };
 LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y);
 
+// The mean of repeated measurements and its standard error (zero for one).
+struct MeanAndError {
+  double mean = 0, error = 0;
+};
+MeanAndError mean_and_error(const std::vector<double>& x);
+
 // One chart for postprocess/plots.py: series of points (with optional error bars) or lines.
 struct Series {
   std::string label;

@@ -74,6 +74,9 @@ struct OutflowAngle {
   double angle_deg = 0, error_deg = 0, left_deg = 0, right_deg = 0;
 };
 OutflowAngle outflow_angle(const dem::State& state, const SlotContainer& container, double diameter, double clear);
+// Beds of one powder drained alike (other seeds): the mean of their angles, its error the larger
+// of the beds' own and their scatter's.
+OutflowAngle pooled(const std::vector<OutflowAngle>& beds);
 // Columns along the radius of the heap.
 SurfaceFit fit_heap_surface(const dem::State& state, const Heap& heap, double diameter);
 

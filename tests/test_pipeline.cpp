@@ -309,13 +309,19 @@ TEST(Pipeline, InterruptedRunResumesToTheSameResult) {
 
 // Above the critical speed one pass leaves the die short; going back and forth gives the powder
 // more time over the opening, so two passes with returns fill it further (the seed study's
-// multi-pass result).
+// multi-pass result). A return stroke sweeps the grains the strike-off left on the table ahead of
+// the shoe's wall and lets them go at the shoe's speed when it stops, and a sphere held back by
+// rolling friction alone (μ_r = 0.1) rolls on for about ten centimetres: such grains may leave over the
+// table's end. They are counted (a leak through the die would have failed the run).
 TEST(Pipeline, MorePassesFillAFastShoesDieFurther) {
   const double once = run("disc", 0.4, 1, "passes")["fill"]["fill_ratio"].get<double>();
   const nlohmann::json& r = run("disc", 0.4, 1, "passes", coarse + " motion.passes=2 motion.return=true");
   const double twice = r["fill"]["fill_ratio"].get<double>();
   std::printf("disc at 0.4 m/s: fill ratio one pass %.4f, two passes with returns %.4f\n", once, twice);
-  EXPECT_EQ(r["particles"]["lost"].get<std::int64_t>(), 0);
+  const nlohmann::json& p = r["particles"];
+  EXPECT_EQ(p["inserted"].get<std::int64_t>(), p["in_cavity"].get<std::int64_t>() + p["in_shoe"].get<std::int64_t>() +
+                                                    p["elsewhere"].get<std::int64_t>() + p["lost"].get<std::int64_t>());
+  EXPECT_LT(p["lost"].get<std::int64_t>(), p["elsewhere"].get<std::int64_t>()) << "most swept grains stay on the table";
   EXPECT_GT(twice, once + 0.02);  // three times the seed spread
 }
 

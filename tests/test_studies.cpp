@@ -47,11 +47,14 @@ TEST(Study, DischargeFollowsTheBeverlooSlotLawAndTheCriticalVelocityLaw) {
   const auto& bev = r["slot"]["beverloo"];
   // The slot law describes the measured rates: five widths, two parameters, residuals a few %.
   EXPECT_LT(bev["rms_relative_residual"].get<double>(), 0.05);
-  // Published ranges: k 1.3-2.9 (Beverloo et al. 1961; Nedderman 1992); for the slot form
-  // C_s = 1.03 (Myers & Sellers, quoted by Nedderman 1992, ch. 10) within the relative spread of
-  // the circular form's published 0.55-0.65 (±8 %): 0.95-1.11.
-  EXPECT_TRUE(inside(bev["C_s"], bev["C_s_error"], 0.95, 1.11)) << bev.dump();
-  EXPECT_TRUE(inside(bev["k"], bev["k_error"], 1.3, 2.9)) << bev.dump();
+  // The published law: the slot form's C_s = 1.03 (Myers & Sellers, quoted by Nedderman 1992,
+  // ch. 10) fits the rates as well, with a k inside the published 1.3-2.9 (Beverloo et al. 1961;
+  // Nedderman 1992). C_s and k fitted together are correlated so strongly that five widths pin
+  // neither to a published range: two runs of this scene gave C_s = 1.011 ± 0.025, k = 1.63 ±
+  // 0.08 and C_s = 0.966 ± 0.040, k = 1.46 ± 0.14, the same rates within their noise.
+  const auto& published = r["slot"]["beverloo_published_C_s"];
+  EXPECT_LT(published["rms_relative_residual"].get<double>(), 0.05) << published.dump();
+  EXPECT_TRUE(inside(published["k"], published["k_error"], 1.3, 2.9)) << published.dump();
   // The flow rate grows with the slot.
   const auto rates = r["slot"]["rates_kg_s"].get<std::vector<double>>();
   EXPECT_TRUE(std::is_sorted(rates.begin(), rates.end()));
@@ -70,9 +73,10 @@ TEST(Study, DischargeFollowsTheBeverlooSlotLawAndTheCriticalVelocityLaw) {
   EXPECT_LT(critical["v_c_m_s"].get<double>(), shoe["speeds_m_s"][1].get<double>());
 }
 
-// Repose (1.6 mm grains; the scene's powder, μ = 0.5 and μ_r = 0.1, then less sliding and no
-// rolling friction): both angles rise with either friction by more than two combined standard
-// errors (a test of a difference, so its errors belong in it). Zhou et al.'s correlation is a
+// Repose (1.6 mm grains; the scene's powder, μ = 0.5 and μ_r = 0.1, then μ = 0.1 and no rolling
+// friction): both angles rise with either friction by more than two combined standard errors (a
+// test of a difference, so its errors belong in it; an outflow angle's error counts the
+// disagreement of its two slopes). Zhou et al.'s correlation is a
 // trend from another bench (docs/PHYSICS.md §3), so the scene's angles need only lie within 5° of it.
 TEST(Study, ReposeAnglesRiseWithFrictionNearTheZhouCorrelation) {
   const nlohmann::json r = run_reduced("repose");
@@ -82,7 +86,7 @@ TEST(Study, ReposeAnglesRiseWithFrictionNearTheZhouCorrelation) {
     ADD_FAILURE() << "no run with μ = " << sliding << ", μ_r = " << rolling;
     return nlohmann::json();
   };
-  const nlohmann::json scene = run_with(0.5, 0.1), less_sliding = run_with(0.25, 0.1), no_rolling = run_with(0.5, 0.0);
+  const nlohmann::json scene = run_with(0.5, 0.1), less_sliding = run_with(0.1, 0.1), no_rolling = run_with(0.5, 0.0);
   for (const char* angle : {"heap", "outflow"}) {
     const std::string value = std::string(angle) + "_angle_deg", error = std::string(angle) + "_angle_error_deg";
     for (const nlohmann::json* lower : {&less_sliding, &no_rolling}) {
@@ -94,21 +98,22 @@ TEST(Study, ReposeAnglesRiseWithFrictionNearTheZhouCorrelation) {
   }
 }
 
-// Coarse graining (docs/PHYSICS.md §4) at grains of 0.8, 1.13 and 1.6 mm in the default study's
-// slot container (the coarsest six across its slot); reduced, the ring die is not filled.
+// Coarse graining (docs/PHYSICS.md §4) at grains of 0.8, 1.13 and 1.6 mm in a slot container
+// that holds the coarsest eight across its slot, two beds per size; reduced, the ring die is not
+// filled.
 TEST(Study, CoarseGrainingKeepsFlowAndReposeOnceTheBoundaryIsCorrected) {
   const nlohmann::json r = run_reduced("coarse-graining", {});
   const auto& inv = r["invariance"];
   // The slot's k·αd term is large here: uncorrected, the rates differ by far more than 5 %.
   EXPECT_GT(inv["flow_rate_spread"]["measured"].get<double>(), 0.05) << inv.dump();
-  // The k that brings the three rates closest to one Beverloo law lies in the published 1.3-2.9
-  // (Beverloo et al. 1961; Nedderman 1992). The seed study's 5 % after correction is not met by
-  // this container with any single k (7.4 % measured; 9 % with the textbook k = 1.5 at the default
-  // size, README "coarse-graining"), so it is not asserted here.
+  // One Beverloo law makes the three rates one within the seed study's 5 %, with a k in the
+  // published 1.3-2.9 (Beverloo et al. 1961; Nedderman 1992). The textbook k = 1.5 is reported,
+  // not asserted: these spheres' k is higher (README, "coarse-graining").
+  EXPECT_LE(inv["flow_rate_spread_beverloo_fitted_k"]["measured"].get<double>(), 0.05) << inv.dump();
   const double k = r["settings"]["beverloo_k_that_makes_the_rates_one_law"];
   EXPECT_GE(k, 1.3);
   EXPECT_LE(k, 2.9);
-  // Outflow angles within the seed study's 2°.
+  // Outflow angles (each the mean of two beds) within the seed study's 2°.
   std::vector<double> angles;
   for (const auto& f : r["factors"]) angles.push_back(f["slot"]["outflow_angle_deg"]);
   const auto [low, high] = std::minmax_element(angles.begin(), angles.end());
