@@ -19,3 +19,7 @@ find_package(ZLIB REQUIRED)
 
 # CGAL must not be configured for Debug-only assertions in Release builds.
 set(CGAL_DO_NOT_WARN_ABOUT_CMAKE_BUILD_TYPE TRUE)
+
+# Optional: with OpenMPI the DEM splits over ranks (dem/mpi_exchange.hpp); without it diefill
+# runs on one process as before.
+find_package(MPI COMPONENTS CXX)

@@ -136,7 +136,8 @@ void pair_forces(const Model& model, State& s) {
   double max_overlap = 0;
   std::int64_t contacts = 0;
   const PairParams* common = model.materials.size() == 1 ? &model.params(0, 0) : nullptr;
-  const std::size_t n = s.size(), block = std::size_t(nl.block_size);
+  // Rows of owned grains only: ghosts (after them) are partners, never rows (state.hpp).
+  const std::size_t n = s.owned(), block = std::size_t(nl.block_size);
   const Vec3* const x = s.x.data();
   const Vec3* const v = s.v.data();
   const Vec3* const w = s.w.data();
@@ -339,7 +340,7 @@ void compute_wall_forces(const Model& model, State& state) { dispatch<WallStage>
 void sum_forces(State& s, double kick_dt) {
   const NeighbourList& nl = s.neighbours;
   const CrossForces& cf = s.cross_forces;
-  const std::size_t n = s.size();
+  const std::size_t n = s.owned();
 #pragma omp parallel for schedule(static)
   for (std::size_t j = 0; j < n; ++j) {
     if (!s.active[j]) continue;
@@ -367,13 +368,15 @@ double elastic_energy(const Model& model, const State& s) {
   };
   double total = 0;
   const NeighbourList& nl = s.neighbours;
-  for (std::size_t i = 0; i + 1 < nl.row_start.size(); ++i)
+  // A pair with a ghost is also counted by the ghost's owner: half here, half there.
+  for (std::size_t i = 0; i < s.owned() && i + 1 < nl.row_start.size(); ++i)
     for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p) {
       const std::size_t j = std::size_t(nl.partner[std::size_t(p)]);
       const double reach = s.radius[i] + s.radius[j];
       const double overlap = reach - (s.x[i] - s.x[j]).norm();
       if (overlap > 0 && s.active[i] && s.active[j])
-        total += energy(model.params(s.material[i], s.material[j]), s.radius[i] * s.radius[j] / reach, overlap);
+        total += (j < s.owned() ? 1.0 : 0.5) *
+                 energy(model.params(s.material[i], s.material[j]), s.radius[i] * s.radius[j] / reach, overlap);
     }
   for (std::int32_t i : nl.near_wall) {
     WallHit hits[wall_slots_per_particle];

@@ -80,12 +80,12 @@ std::uint64_t morton(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
   return spread(x) << 2 | spread(y) << 1 | spread(z);
 }
 
-// Active particles along the Morton curve of their cells (ties in index order), lost ones after
-// them in their old order. new_index: old index -> new.
+// Active owned particles along the Morton curve of their cells (ties in index order), lost ones
+// after them in their old order, then the ghosts as they came. new_index: old index -> new.
 std::vector<std::int32_t> sort_particles(State& s, const CellGrid& g, std::vector<std::int32_t>& new_index) {
   std::vector<std::pair<std::uint64_t, std::int32_t>> keyed;
   keyed.reserve(s.size());
-  for (std::size_t i = 0; i < s.size(); ++i)
+  for (std::size_t i = 0; i < s.owned(); ++i)
     if (s.active[i])
       keyed.push_back({morton(std::uint32_t(g.cell_coord(s.x[i].x(), 0)), std::uint32_t(g.cell_coord(s.x[i].y(), 1)),
                               std::uint32_t(g.cell_coord(s.x[i].z(), 2))),
@@ -94,8 +94,9 @@ std::vector<std::int32_t> sort_particles(State& s, const CellGrid& g, std::vecto
   std::vector<std::int32_t> order;
   order.reserve(s.size());
   for (const auto& [key, i] : keyed) order.push_back(i);
-  for (std::size_t i = 0; i < s.size(); ++i)
+  for (std::size_t i = 0; i < s.owned(); ++i)
     if (!s.active[i]) order.push_back(std::int32_t(i));
+  for (std::size_t i = s.owned(); i < s.size(); ++i) order.push_back(std::int32_t(i));
   new_index.assign(s.size(), -1);
   for (std::size_t n = 0; n < order.size(); ++n) new_index[std::size_t(order[n])] = std::int32_t(n);
   permute(s.id, order);
@@ -142,13 +143,14 @@ std::int32_t block_size_for(std::size_t n) { return std::int32_t(std::clamp<std:
 
 // The cross pairs (partner in a later block): each row's buffer slots in pair order, and for each
 // partner the slots naming it, ascending.
-void index_cross_pairs(NeighbourList& nl, std::size_t n) {
-  nl.block_size = block_size_for(n);
+void index_cross_pairs(NeighbourList& nl, std::size_t n, std::size_t owned) {
+  nl.block_size = block_size_for(owned);
   const std::size_t block = std::size_t(nl.block_size);
   nl.cross_start.assign(n + 1, 0);
   nl.cross_reverse_start.assign(n + 1, 0);
+  // Blocks cover the owned grains; a ghost partner (after them) is always a cross pair.
   for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t block_end = std::min(n, (i / block + 1) * block);
+    const std::size_t block_end = std::min(owned, (i / block + 1) * block);
     std::int32_t cross = 0;
     for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p)
       if (std::size_t(nl.partner[std::size_t(p)]) >= block_end) ++cross, ++nl.cross_reverse_start[std::size_t(nl.partner[std::size_t(p)]) + 1];
@@ -158,11 +160,40 @@ void index_cross_pairs(NeighbourList& nl, std::size_t n) {
   nl.cross_reverse.resize(std::size_t(nl.cross_start[n]));
   std::vector<std::int32_t> fill(nl.cross_reverse_start.begin(), nl.cross_reverse_start.end() - 1);
   for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t block_end = std::min(n, (i / block + 1) * block);
+    const std::size_t block_end = std::min(owned, (i / block + 1) * block);
     std::int32_t slot = nl.cross_start[i];
     for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p)
       if (const std::size_t j = std::size_t(nl.partner[std::size_t(p)]); j >= block_end) nl.cross_reverse[std::size_t(fill[j]++)] = slot++;
   }
+}
+
+// The histories of the list's pairs, by (old) particle index.
+std::vector<OldPair> listed_histories(const NeighbourList& nl) {
+  std::vector<OldPair> old;
+  old.reserve(nl.partner.size() / 2);
+  for (std::size_t i = 0; i + 1 < nl.row_start.size(); ++i)
+    for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p) {
+      const Vec3 t = nl.tangential.empty() ? Vec3::Zero() : nl.tangential[std::size_t(p)];
+      const Vec3 r = nl.rolling.empty() ? Vec3::Zero() : nl.rolling[std::size_t(p)];
+      if (t.squaredNorm() > 0 || r.squaredNorm() > 0) old.push_back({std::int32_t(i), nl.partner[std::size_t(p)], t, r});
+    }
+  return old;
+}
+
+// The histories that came with migrated grains (global ids), by their new local indices.
+std::vector<OldPair> carried_histories(State& s) {
+  std::vector<std::pair<std::int64_t, std::int32_t>> index_of(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) index_of[i] = {s.id[i], std::int32_t(i)};
+  std::sort(index_of.begin(), index_of.end());
+  const auto find = [&](std::int64_t id) {
+    const auto at = std::lower_bound(index_of.begin(), index_of.end(), std::pair{id, std::int32_t(-1)});
+    return at != index_of.end() && at->first == id ? at->second : -1;
+  };
+  std::vector<OldPair> old;
+  for (const CarriedPair& c : s.carried_pairs)
+    if (const std::int32_t i = find(c.id), j = find(c.partner); i >= 0 && j >= 0) old.push_back({i, j, c.tangential, c.rolling});
+  s.carried_pairs.clear();
+  return old;
 }
 
 }  // namespace
@@ -190,7 +221,7 @@ void rebuild_neighbours(const Model& model, State& s) {
     s.w[i].setZero();
     ++s.lost;
   };
-  for (std::size_t i = 0; i < s.size(); ++i)
+  for (std::size_t i = 0; i < s.owned(); ++i)
     if (s.active[i] && s.body[i] < 0 && !model.domain.contains(s.x[i])) lose(i);
   Bodies& bodies = s.bodies;
   for (std::size_t b = 0; b < bodies.size(); ++b)
@@ -202,43 +233,42 @@ void rebuild_neighbours(const Model& model, State& s) {
         lose(std::size_t(bodies.member[std::size_t(k)]));
     }
 
-  // Old pairs with their history, by particle index before sorting.
+  // Old pairs with their history, by particle index before sorting (or, split over ranks, the
+  // histories that came with the grains, by global id: exchange.hpp).
   NeighbourList& nl = s.neighbours;
   const bool tangential = model.tangential != TangentialLaw::none, rolling = model.rolling == RollingLaw::epsd;
-  std::vector<OldPair> old;
-  old.reserve(nl.partner.size() / 2);
-  for (std::size_t i = 0; i + 1 < nl.row_start.size(); ++i)
-    for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p) {
-      const Vec3 t = nl.tangential.empty() ? Vec3::Zero() : nl.tangential[std::size_t(p)];
-      const Vec3 r = nl.rolling.empty() ? Vec3::Zero() : nl.rolling[std::size_t(p)];
-      if (t.squaredNorm() > 0 || r.squaredNorm() > 0) old.push_back({std::int32_t(i), nl.partner[std::size_t(p)], t, r});
-    }
+  std::vector<OldPair> old = s.exchange ? std::vector<OldPair>() : listed_histories(nl);
   const Array<std::int32_t> old_near = nl.near_wall;
   const Array<WallSlot> old_slots = std::move(s.wall_slots);
 
   CellGrid grid = make_grid(model, s);
   std::vector<std::int32_t> new_index;
   const std::vector<std::int32_t> order = sort_particles(s, grid, new_index);
+  if (s.exchange) s.exchange->reordered(new_index);
   grid = make_grid(model, s);  // members now ascending along the cells
-  // Re-key old pairs to the new indices, smaller index first (history is i's view: negate).
+  if (s.exchange) old = carried_histories(s);
+  else
+    for (OldPair& o : old) o.i = new_index[std::size_t(o.i)], o.j = new_index[std::size_t(o.j)];
+  // Smaller index first (history is i's view: negate).
   for (OldPair& o : old) {
-    o.i = new_index[std::size_t(o.i)];
-    o.j = new_index[std::size_t(o.j)];
     if (o.i > o.j) {
       std::swap(o.i, o.j);
       o.tangential = -o.tangential;
       o.rolling = -o.rolling;
     }
   }
-  std::sort(old.begin(), old.end(), [](const OldPair& a, const OldPair& b) {
+  // Stable: split over ranks, a pair that met across a subdomain face comes once from each side
+  // (the two views agree to rounding), in an order that is the same every run.
+  std::stable_sort(old.begin(), old.end(), [](const OldPair& a, const OldPair& b) {
     return a.i != b.i ? a.i < b.i : a.j < b.j;
   });
 
-  // Rows in parallel: every particle scans the 27 cells around it for j > i within reach.
+  // Rows in parallel: every owned particle scans the 27 cells around it for j > i within reach
+  // (ghosts, after the owned ones, are partners only).
   const std::size_t n = s.size();
   std::vector<std::vector<std::int32_t>> rows(n);
 #pragma omp parallel for schedule(dynamic, 256)
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < s.owned(); ++i) {
     if (!s.active[i]) continue;
     const Vec3& xi = s.x[i];
     const std::int32_t body = s.body[i];
@@ -293,7 +323,7 @@ void rebuild_neighbours(const Model& model, State& s) {
     }
     cursor = row_end;
   }
-  index_cross_pairs(nl, n);
+  index_cross_pairs(nl, n, s.owned());
   s.cross_forces.force.assign(nl.cross_reverse.size(), Vec3::Zero());
   s.cross_forces.torque.assign(nl.cross_reverse.size(), Vec3::Zero());
 

@@ -6,9 +6,11 @@
 // B rigid bodies (clumps) with M members in all.
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "dem/contact.hpp"
+#include "dem/exchange.hpp"
 #include "dem/types.hpp"
 
 namespace dem {
@@ -124,6 +126,13 @@ struct State {
   Array<double> scratch_wall_power;  // [near-wall grains], summed serially
   Array<WallCandidates> wall_candidates;  // [near-wall grains x mesh walls], see walls.hpp
 
+  // Split over MPI ranks (exchange.hpp): the last `ghosts` particles are copies of other ranks'
+  // grains, never integrated; the contact histories that came with migrated grains wait in
+  // carried_pairs for the next list build.
+  std::shared_ptr<Exchange> exchange;
+  std::size_t ghosts = 0;
+  std::vector<CarriedPair> carried_pairs;
+
   double time = 0;              // [s]
   std::int64_t step = 0;
   std::int64_t lost = 0;        // particles that left the domain
@@ -133,6 +142,7 @@ struct State {
   bool energy_reference_set = false;
 
   std::size_t size() const { return x.size(); }
+  std::size_t owned() const { return x.size() - ghosts; }
   // Every array's allocation [bytes], for the benchmarks' bytes per particle.
   std::size_t memory_bytes() const;
   // Appends a sphere; density in kg/m³.

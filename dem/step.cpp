@@ -21,9 +21,9 @@ namespace {
 double kick_and_drift(State& s, double half_dt, double dt) {
   kick_bodies(s, half_dt);
   drift_bodies(s, dt);
-  const std::size_t n = s.size();
+  const std::size_t n = s.owned();
   const Array<Vec3>& built = s.neighbours.x_at_build;
-  const bool listed = built.size() == n;
+  const bool listed = built.size() == s.size();
   double largest = 0;
 #pragma omp parallel for schedule(static) reduction(max : largest)
   for (std::size_t i = 0; i < n; ++i) {
@@ -35,7 +35,7 @@ double kick_and_drift(State& s, double half_dt, double dt) {
     }
     if (listed) largest = std::max(largest, (s.x[i] - built[i]).squaredNorm());
   }
-  return largest;
+  return s.exchange ? s.exchange->max(largest) : largest;
 }
 
 // Forces on every grain; with kick_dt > 0 the second half kick of velocity Verlet follows in
@@ -93,9 +93,14 @@ std::string worst_overlap(const Model& model, const State& s) {
 // Mechanical energy may only grow by what walls deliver; checked every `energy_interval` steps.
 constexpr int energy_interval = 200;
 
+// The sum or the largest value over the ranks (the local one on a single process).
+double global_sum(const State& s, double local) { return s.exchange ? s.exchange->sum(local) : local; }
+double global_max(const State& s, double local) { return s.exchange ? s.exchange->max(local) : local; }
+
 StepReport monitor(const Model& model, State& s) {
   StepReport r;
-  s.wall_work += s.counters.wall_power * model.dt;
+  s.wall_work += global_sum(s, s.counters.wall_power) * model.dt;
+  s.counters.max_overlap_rel = global_max(s, s.counters.max_overlap_rel);
   if (s.counters.max_overlap_rel > model.stop_overlap) {
     r.status = StepStatus::overlap;
     r.message = fmt::format(
@@ -106,15 +111,17 @@ StepReport monitor(const Model& model, State& s) {
     return r;
   }
   if (s.step % energy_interval != 0) return r;
-  for (std::size_t i = 0; i < s.size(); ++i)
-    if (s.active[i] && !(s.x[i].allFinite() && s.v[i].allFinite() && s.w[i].allFinite())) {
-      r.status = StepStatus::non_finite;
-      r.message = fmt::format("grain {} has a non-finite position or velocity at t = {:.6g} s: the "
-                              "integration diverged. Lower simulation.time_step",
-                              s.id[i], s.time);
-      return r;
-    }
-  const double energy = kinetic_energy(s) + potential_energy(model, s) + elastic_energy(model, s);
+  std::int64_t diverged = -1;
+  for (std::size_t i = 0; i < s.owned() && diverged < 0; ++i)
+    if (s.active[i] && !(s.x[i].allFinite() && s.v[i].allFinite() && s.w[i].allFinite())) diverged = s.id[i];
+  if (global_max(s, double(diverged)) >= 0) {
+    r.status = StepStatus::non_finite;
+    r.message = fmt::format("grain {} has a non-finite position or velocity at t = {:.6g} s: the "
+                            "integration diverged. Lower simulation.time_step",
+                            std::int64_t(global_max(s, double(diverged))), s.time);
+    return r;
+  }
+  const double energy = global_sum(s, kinetic_energy(s) + potential_energy(model, s) + elastic_energy(model, s));
   if (s.energy_reference_set) {
     const double budget = s.energy_reference + s.wall_work;
     s.counters.energy_gain = (energy - budget) / std::max(s.energy_scale, 1e-300);
@@ -136,14 +143,14 @@ StepReport monitor(const Model& model, State& s) {
 // Clump members carry their body's motion: their energy is the body's, counted once.
 double kinetic_energy(const State& s) {
   double e = 0;
-  for (std::size_t i = 0; i < s.size(); ++i)
+  for (std::size_t i = 0; i < s.owned(); ++i)
     if (s.active[i] && s.body[i] < 0) e += 0.5 * s.mass[i] * s.v[i].squaredNorm() + 0.5 * s.inertia[i] * s.w[i].squaredNorm();
   return e + body_kinetic_energy(s);
 }
 
 double potential_energy(const Model& model, const State& s) {
   double e = 0;
-  for (std::size_t i = 0; i < s.size(); ++i)
+  for (std::size_t i = 0; i < s.owned(); ++i)
     if (s.active[i] && s.body[i] < 0) e -= s.mass[i] * model.gravity.dot(s.x[i]);
   return e + body_potential_energy(model, s);
 }
@@ -151,16 +158,18 @@ double potential_energy(const Model& model, const State& s) {
 void initialize(const Model& model, State& s) {
   s.f.resize(s.size(), Vec3::Zero());
   s.torque.resize(s.size(), Vec3::Zero());
+  if (s.exchange) s.exchange->redistribute(model, s);
   rebuild_neighbours(model, s);
   forces(model, s, nullptr, 0);
-  s.energy_reference = kinetic_energy(s) + potential_energy(model, s) + elastic_energy(model, s);
+  s.energy_reference = global_sum(s, kinetic_energy(s) + potential_energy(model, s) + elastic_energy(model, s));
   s.energy_scale = 0;
-  for (std::size_t i = 0; i < s.size(); ++i)
+  for (std::size_t i = 0; i < s.owned(); ++i)
     if (s.body[i] < 0) s.energy_scale += s.mass[i] * model.gravity.norm() * s.radius[i];
   for (std::size_t b = 0; b < s.bodies.size(); ++b)
     for (std::int32_t k = s.bodies.member_start[b]; k < s.bodies.member_start[b + 1]; ++k)
       s.energy_scale += s.bodies.mass[b] * model.gravity.norm() * s.radius[std::size_t(s.bodies.member[std::size_t(k)])] /
                         double(s.bodies.member_start[b + 1] - s.bodies.member_start[b]);
+  s.energy_scale = global_sum(s, s.energy_scale);
   s.energy_reference_set = true;
 }
 
@@ -170,7 +179,12 @@ StepReport step(const Model& model, State& s, StageTimes* times) {
   s.time += model.dt;
   ++s.step;
   if (times) times->integration += clock.seconds(), clock.restart();
-  if (needs_rebuild(model, s, largest_shift2)) rebuild_neighbours(model, s);
+  if (needs_rebuild(model, s, largest_shift2)) {
+    if (s.exchange) s.exchange->redistribute(model, s);
+    rebuild_neighbours(model, s);
+  } else if (s.exchange) {
+    s.exchange->update_ghosts(s);
+  }
   if (times) times->neighbours += clock.seconds(), clock.restart();
   forces(model, s, times, 0.5 * model.dt);
   clock.restart();

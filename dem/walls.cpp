@@ -57,7 +57,7 @@ double wall_distance(const Model& model, double time, const Vec3& x) {
 void collect_near_wall(const Model& model, State& s) {
   Array<std::int32_t>& near = s.neighbours.near_wall;
   near.clear();
-  for (std::size_t i = 0; i < s.size(); ++i) {
+  for (std::size_t i = 0; i < s.owned(); ++i) {
     if (!s.active[i]) continue;
     const double reach = s.radius[i] + model.skin;
     bool close = false;

@@ -25,6 +25,7 @@ packages=(
   python3-openvdb python3-numpy libopenvdb-tools   # independent readers of our outputs in the tests:
   python3-vtk9 python3-meshio                     # OpenVDB, VTK and meshio, not our code
   python3-matplotlib                        # the pictures of reports and studies
+  libopenmpi-dev openmpi-bin                # the DEM split over MPI ranks (dem/mpi_exchange.hpp)
 )
 missing=()
 for p in "${packages[@]}"; do
