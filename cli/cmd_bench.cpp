@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "cli/commands.hpp"
+#include "cli/mpi_session.hpp"
 #include "pipeline/die_fill.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
@@ -88,30 +89,51 @@ dem::State read_lammps_dump(const fs::path& path, const dem::Material& m) {
 }
 
 
+// Under mpirun, this rank's share of the pack: every ranks-th grain (they migrate to their
+// subdomains at the first build), with the exchange that splits the run.
+dem::State share_of(const dem::State& pack, const std::shared_ptr<dem::Exchange>& exchange) {
+  if (!exchange) return pack;
+  dem::State s;
+  for (std::size_t i = std::size_t(exchange->rank()); i < pack.size(); i += std::size_t(exchange->ranks())) {
+    s.add_sphere(pack.id[i], pack.x[i], pack.radius[i], 1.0, pack.material[i], pack.v[i], pack.w[i]);
+    s.mass.back() = pack.mass[i], s.inertia.back() = pack.inertia[i];
+  }
+  s.exchange = exchange;
+  return s;
+}
+
 json time_case(const std::string& name, const dem::Model& model, const dem::State& pack, int steps,
                const std::vector<int>& thread_counts) {
+  const std::shared_ptr<dem::Exchange> exchange = mpi_exchange();
+  const int ranks = exchange ? exchange->ranks() : 1;
+  // Over the ranks (the local value on one process).
+  const auto total = [&](double local) { return exchange ? exchange->sum(local) : local; };
+  const auto largest = [&](double local) { return exchange ? exchange->max(local) : local; };
+  const double grains = double(pack.size());
   json runs = json::array();
   for (int threads : thread_counts) {
     omp_set_num_threads(threads);
-    dem::State s = pack;
+    dem::State s = share_of(pack, exchange);
     dem::initialize(model, s);
     for (int n = 0; n < std::min(200, steps / 10); ++n) dem::step(model, s);  // warm-up
     dem::StageTimes times;
+    largest(0);  // every rank starts the clock together
     diefill::Stopwatch clock;
     const std::int64_t builds = s.neighbours.builds;
     for (int n = 0; n < steps; ++n) dem::step(model, s, &times);
-    const double wall = clock.seconds();
-    const double rate = double(steps) * double(s.size()) / wall;
+    const double wall = largest(clock.seconds());
+    const double rate = double(steps) * grains / wall;
     runs.push_back({{"threads", threads},
+                    {"ranks", ranks},
                     {"steps", steps},
                     {"wall_s", wall},
                     {"particle_steps_per_s", rate},
-                    {"particle_steps_per_s_per_core", rate / threads},
+                    {"particle_steps_per_s_per_core", rate / (threads * ranks)},
                     {"neighbour_builds", s.neighbours.builds - builds},
-                    {"contacts_per_grain", double(s.counters.contacts) * 2.0 / double(s.size())},
-                    {"listed_pairs_per_grain", double(s.neighbours.partner.size()) * 2.0 / double(s.size())},
-                    {"near_wall_grains", s.neighbours.near_wall.size()},
-                    {"wall_contacts", s.counters.wall_contacts},
+                    {"contacts_per_grain", total(double(s.counters.contacts)) * 2.0 / grains},
+                    {"listed_pairs_per_grain", total(double(s.neighbours.partner.size())) * 2.0 / grains},
+                    {"near_wall_grains", total(double(s.neighbours.near_wall.size()))},
+                    {"wall_contacts", total(double(s.counters.wall_contacts))},
                     {"stages_s",
                      {{"neighbours", times.neighbours},
                       {"pair_forces", times.pair_forces},
@@ -120,8 +142,11 @@ json time_case(const std::string& name, const dem::Model& model, const dem::Stat
                       {"integration", times.integration},
                       {"monitor", times.monitor}}}});
     diefill::log::info("bench {}: {} threads, {:.3g} particle-steps/s", name, threads, rate);
-    if (threads == thread_counts.back())
-      runs.back()["bytes_per_particle"] = double(s.memory_bytes()) / double(s.size());
+    if (threads == thread_counts.back()) {
+      // Per owned grain, ghosts included, on the rank that holds the most.
+      runs.back()["bytes_per_particle"] = largest(double(s.memory_bytes()) / double(std::max<std::size_t>(1, s.owned())));
+      if (exchange) runs.back()["largest_share_of_grains_with_ghosts"] = largest(double(s.size()) / grains);
+    }
   }
   return {{"case", name}, {"grains", pack.size()}, {"dt_s", model.dt}, {"runs", runs}};
 }
@@ -270,6 +295,7 @@ int run_bench(const BenchCommand& c) {
     }
   }
   const std::string text = results.dump(2) + "\n";
+  if (const auto ranks = mpi_exchange(); ranks && ranks->rank() != 0) return diefill::exit_ok;  // rank 0 reports
   if (c.json_out.empty()) fmt::print("{}", text);
   else diefill::write_file_atomic(c.json_out, text);
   return 0;

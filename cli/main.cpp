@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include "cli/commands.hpp"
+#include "cli/mpi_session.hpp"
 #include "studies/studies.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -125,6 +126,7 @@ void add_study(CLI::App& root, app::study::StudyRequest& c, std::function<int()>
 }  // namespace
 
 int main(int argc, char** argv) {
+  const app::MpiSession mpi(argc, argv);
   CLI::App root{"diefill: simulate how a powder fills a press die"};
   root.set_version_flag("--version", [] { return app::version_text(); });
   root.require_subcommand(1);
@@ -157,6 +159,11 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     const int status = root.exit(e);
     return status == 0 ? 0 : diefill::exit_bad_input;
+  }
+  if (const auto ranks = app::mpi_exchange(); ranks && ranks->ranks() > 1 && !root.got_subcommand("bench")) {
+    fmt::print(stderr, "error: mpirun: only `diefill bench` is split over MPI ranks so far; run the other commands "
+                       "without mpirun (they use every core through threads)\n");
+    return diefill::exit_bad_input;
   }
   try {
     return action ? action() : diefill::exit_ok;

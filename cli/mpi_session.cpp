@@ -1,0 +1,44 @@
+#include "cli/mpi_session.hpp"
+
+#include <cstdlib>
+
+#include "core/log.hpp"
+
+#ifdef DIEFILL_HAVE_MPI
+#include <mpi.h>
+
+#include "dem/mpi_exchange.hpp"
+#endif
+
+namespace app {
+
+namespace {
+std::shared_ptr<dem::Exchange> session_exchange;
+}
+
+#ifdef DIEFILL_HAVE_MPI
+// OpenMPI's launcher sets OMPI_COMM_WORLD_SIZE in every rank's environment.
+MpiSession::MpiSession(int& argc, char**& argv) {
+  if (!std::getenv("OMPI_COMM_WORLD_SIZE")) return;
+  MPI_Init(&argc, &argv);
+  session_exchange = dem::make_mpi_exchange();
+  // One progress line and one result: rank 0's. Errors still come from every rank.
+  if (session_exchange->rank() != 0) diefill::log::set_level(diefill::log::Level::quiet);
+}
+MpiSession::~MpiSession() {
+  if (!session_exchange) return;
+  session_exchange.reset();
+  MPI_Finalize();
+}
+#else
+MpiSession::MpiSession(int&, char**&) {
+  if (std::getenv("OMPI_COMM_WORLD_SIZE"))
+    diefill::log::warn("launched by mpirun, but this diefill was built without OpenMPI: every rank runs the whole job "
+                       "(install libopenmpi-dev and rebuild)");
+}
+MpiSession::~MpiSession() = default;
+#endif
+
+std::shared_ptr<dem::Exchange> mpi_exchange() { return session_exchange; }
+
+}  // namespace app

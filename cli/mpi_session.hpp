@@ -1,0 +1,22 @@
+#pragma once
+// MPI for a run launched by mpirun (docs/ARCHITECTURE.md, "Domain decomposition"): initialised
+// for the program's life when the launcher's environment says so and the build has OpenMPI;
+// otherwise nothing, and diefill runs as one process.
+#include <memory>
+
+#include "dem/exchange.hpp"
+
+namespace app {
+
+class MpiSession {
+ public:
+  MpiSession(int& argc, char**& argv);
+  ~MpiSession();
+  MpiSession(const MpiSession&) = delete;
+  MpiSession& operator=(const MpiSession&) = delete;
+};
+
+// The exchange of this run's ranks; null on one process without mpirun.
+std::shared_ptr<dem::Exchange> mpi_exchange();
+
+}  // namespace app
