@@ -145,7 +145,10 @@ json time_case(const std::string& name, const dem::Model& model, const dem::Stat
     if (threads == thread_counts.back()) {
       // Per owned grain, ghosts included, on the rank that holds the most.
       runs.back()["bytes_per_particle"] = largest(double(s.memory_bytes()) / double(std::max<std::size_t>(1, s.owned())));
-      if (exchange) runs.back()["largest_share_of_grains_with_ghosts"] = largest(double(s.size()) / grains);
+      if (exchange) {
+        runs.back()["largest_share_of_grains_with_ghosts"] = largest(double(s.size()) / grains);
+        runs.back()["ghost_bytes_per_step"] = largest(double(exchange->ghost_bytes_per_step()));
+      }
     }
   }
   return {{"case", name}, {"grains", pack.size()}, {"dt_s", model.dt}, {"runs", runs}};

@@ -17,9 +17,14 @@ std::shared_ptr<dem::Exchange> session_exchange;
 }
 
 #ifdef DIEFILL_HAVE_MPI
-// OpenMPI's launcher sets OMPI_COMM_WORLD_SIZE in every rank's environment.
+namespace {
+// OpenMPI's mpirun sets OMPI_COMM_WORLD_SIZE in every rank's environment; a direct launch by a
+// scheduler (srun) sets PMIx's or PMI's rank.
+bool launched_by_mpi() { return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMIX_RANK") || std::getenv("PMI_RANK"); }
+}  // namespace
+
 MpiSession::MpiSession(int& argc, char**& argv) {
-  if (!std::getenv("OMPI_COMM_WORLD_SIZE")) return;
+  if (!launched_by_mpi()) return;
   MPI_Init(&argc, &argv);
   session_exchange = dem::make_mpi_exchange();
   // One progress line and one result: rank 0's. Errors still come from every rank.

@@ -4,6 +4,7 @@
 // reach of it. This is what the step asks of the other ranks; a run on one process has no
 // exchange (State::exchange is null) and makes no call. The MPI implementation
 // (dem/mpi_exchange.cpp) is a library of its own, so that the DEM itself links no MPI.
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -41,6 +42,8 @@ class Exchange {
   virtual void reordered(const std::vector<std::int32_t>& new_index) = 0;
   // Every step without a rebuild: the ghosts' positions and velocities, from their owners.
   virtual void update_ghosts(State& state) = 0;
+  // What this rank sends in one update_ghosts [bytes].
+  virtual std::size_t ghost_bytes_per_step() const = 0;
 };
 
 }  // namespace dem

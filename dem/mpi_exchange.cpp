@@ -122,6 +122,11 @@ class MpiExchange final : public Exchange {
       for (std::int32_t& i : list) i = new_index[std::size_t(i)];
   }
   void update_ghosts(State& s) override;
+  std::size_t ghost_bytes_per_step() const override {
+    std::size_t grains = 0;
+    for (const auto& list : send_) grains += list.size();
+    return grains * sizeof(GhostMotion);
+  }
 
  private:
   // Each rank's buffer to it; returns what every rank sent here, in rank order.
