@@ -22,7 +22,8 @@ for case in json.load(open(sys.argv[1]))["cases"]:
     print(f'{sys.argv[2]},{case["grains"]},{run["particle_steps_per_s"]},{run["bytes_per_particle"]}')
 PY
 done
-python3 - "$csv" "$root/bench/results/scaling.json" "$root/docs/scaling.png" <<'PY'
+# Debian's Python, which has matplotlib (scripts/setup.sh), whatever python3 the PATH finds first.
+/usr/bin/python3 - "$csv" "$root/bench/results/scaling.json" "$root/docs/scaling.png" <<'PY'
 import csv, json, statistics, sys
 import matplotlib
 matplotlib.use("Agg")
