@@ -141,7 +141,7 @@ class MpiExchange final : public Exchange {
     }
     return cuts_[std::size_t(node)].rank;
   }
-  void migrate(const Model& model, State& s);
+  void migrate(State& s);
   void send_ghosts(const Model& model, State& s);
 
   int rank_ = 0, ranks_ = 1;
@@ -222,12 +222,11 @@ void MpiExchange::redistribute(const Model& model, State& s) {
   if (s.bodies.size() > 0)
     throw diefill::InputError("mpirun", "ranks", "clump grains are not split over MPI ranks yet",
                               "Run clump grains on one process (threads), or use spheres");
-  migrate(model, s);
+  migrate(s);
   send_ghosts(model, s);
 }
 
-void MpiExchange::migrate(const Model& model, State& s) {
-  (void)model;
+void MpiExchange::migrate(State& s) {
   const std::size_t owned = s.owned();
   const NeighbourList& nl = s.neighbours;
   const bool listed = nl.row_start.size() == s.size() + 1;

@@ -4,7 +4,6 @@
 // the same rank count gives the same bits.
 #include <gtest/gtest.h>
 #include <mpi.h>
-#include <omp.h>
 
 #include <algorithm>
 #include <map>
@@ -89,16 +88,16 @@ dem::State split(const dem::State& whole) {
   return s;
 }
 
-std::map<std::int64_t, std::size_t> index_by_id(const dem::State& s, std::size_t count) {
+std::map<std::int64_t, std::size_t> index_by_id(const dem::State& s) {
   std::map<std::int64_t, std::size_t> m;
-  for (std::size_t i = 0; i < count; ++i) m[s.id[i]] = i;
+  for (std::size_t i = 0; i < s.size(); ++i) m[s.id[i]] = i;
   return m;
 }
 
 // Every owned grain against the reference: force within 1e-12 of the largest force, position and
 // velocity to rounding.
 void expect_matches(const dem::State& part, const dem::State& whole, const char* when) {
-  const auto reference = index_by_id(whole, whole.size());
+  const auto reference = index_by_id(whole);
   double force_scale = 0, speed_scale = 0;
   for (std::size_t i = 0; i < whole.size(); ++i)
     force_scale = std::max(force_scale, whole.f[i].norm()), speed_scale = std::max(speed_scale, whole.v[i].norm());
