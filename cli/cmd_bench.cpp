@@ -15,6 +15,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/mpi_session.hpp"
+#include "dem/distributed.hpp"
 #include "pipeline/die_fill.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
@@ -89,19 +90,6 @@ dem::State read_lammps_dump(const fs::path& path, const dem::Material& m) {
 }
 
 
-// Under mpirun, this rank's share of the pack: every ranks-th grain (they migrate to their
-// subdomains at the first build), with the exchange that splits the run.
-dem::State share_of(const dem::State& pack, const std::shared_ptr<dem::Exchange>& exchange) {
-  if (!exchange) return pack;
-  dem::State s;
-  for (std::size_t i = std::size_t(exchange->rank()); i < pack.size(); i += std::size_t(exchange->ranks())) {
-    s.add_sphere(pack.id[i], pack.x[i], pack.radius[i], 1.0, pack.material[i], pack.v[i], pack.w[i]);
-    s.mass.back() = pack.mass[i], s.inertia.back() = pack.inertia[i];
-  }
-  s.exchange = exchange;
-  return s;
-}
-
 json time_case(const std::string& name, const dem::Model& model, const dem::State& pack, int steps,
                const std::vector<int>& thread_counts) {
   const std::shared_ptr<dem::Exchange> exchange = mpi_exchange();
@@ -113,7 +101,7 @@ json time_case(const std::string& name, const dem::Model& model, const dem::Stat
   json runs = json::array();
   for (int threads : thread_counts) {
     omp_set_num_threads(threads);
-    dem::State s = share_of(pack, exchange);
+    dem::State s = dem::share_of(pack, exchange);
     dem::initialize(model, s);
     for (int n = 0; n < std::min(200, steps / 10); ++n) dem::step(model, s);  // warm-up
     dem::StageTimes times;

@@ -7,6 +7,7 @@
 #include <set>
 
 #include "cli/commands.hpp"
+#include "cli/mpi_session.hpp"
 #include "pipeline/die_fill.hpp"
 #include "pipeline/run_loop.hpp"
 #include "core/atomic_file.hpp"
@@ -66,17 +67,20 @@ int run_scene(const SceneCommand& c) {
 
 int run_pipeline(const RunCommand& c) {
   install_interrupt_handler();
+  // Under mpirun every rank runs this; rank 0 reports (pipeline/die_fill.hpp).
+  const std::shared_ptr<dem::Exchange> ranks = mpi_exchange();
+  const bool root = !ranks || ranks->rank() == 0;
   if (!fs::is_directory(c.target)) {
     PipelineScene scene = scene_for(c.target, c.overrides);
     apply_command_line(scene, c);
     if (scene.die.empty())
       throw diefill::InputError(c.target.string(), "die.file", "names no die", "Give [die] file = \"...\" or run a mesh");
-    const DieRun run = run_die_fill(scene, scene.die, c.resume);
+    const DieRun run = run_die_fill(scene, scene.die, c.resume, ranks);
     if (run.interrupted) {
-      fmt::print(stderr, "interrupted; resume with `diefill run {} --resume`\n", c.target.string());
+      if (root) fmt::print(stderr, "interrupted; resume with `diefill run {} --resume`\n", c.target.string());
       return diefill::exit_interrupted;
     }
-    fmt::print("{}: report {}\n", run.die, (run.dir / "report.json").string());
+    if (root) fmt::print("{}: report {}\n", run.die, (run.dir / "report.json").string());
     return 0;
   }
   // A folder: every mesh into its own folder, then a summary table.
@@ -86,7 +90,7 @@ int run_pipeline(const RunCommand& c) {
   std::string md = "| die | status | grains in cavity | fill ratio | mean | std | min | max |\n|---|---|---|---|---|---|---|---|\n";
   int refused = 0, unstable = 0;
   const auto record_failure = [&](const fs::path& mesh, const char* status, std::string message) {
-    fmt::print(stderr, "error: {}\n", message);
+    if (root) fmt::print(stderr, "error: {}\n", message);
     std::replace(message.begin(), message.end(), ',', ';');
     std::replace(message.begin(), message.end(), '|', '/');
     csv += fmt::format("{},{},,,,,,,{}\n", mesh.stem().string(), status, message);
@@ -94,8 +98,9 @@ int run_pipeline(const RunCommand& c) {
   };
   for (const fs::path& mesh : meshes_in(c.target)) {
     try {
-      const DieRun run = run_die_fill(scene, mesh, c.resume);
+      const DieRun run = run_die_fill(scene, mesh, c.resume, ranks);
       if (run.interrupted) return diefill::exit_interrupted;
+      if (!root) continue;
       const auto& fill = run.report["fill"];
       const auto value = [&](const char* key) { return fill.value(key, 0.0); };
       csv += fmt::format("{},ok,{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},\n", run.die, run.report["particles"]["in_cavity"].get<std::size_t>(),
@@ -113,9 +118,11 @@ int run_pipeline(const RunCommand& c) {
       record_failure(mesh, "stopped", e.what());
     }
   }
-  diefill::write_file_atomic(scene.out / "summary.csv", csv);
-  diefill::write_file_atomic(scene.out / "summary.md", md);
-  fmt::print("{}", md);
+  if (root) {
+    diefill::write_file_atomic(scene.out / "summary.csv", csv);
+    diefill::write_file_atomic(scene.out / "summary.md", md);
+    fmt::print("{}", md);
+  }
   return unstable > 0 ? diefill::exit_unstable : refused > 0 ? diefill::exit_bad_input : diefill::exit_ok;
 }
 

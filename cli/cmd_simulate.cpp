@@ -6,11 +6,13 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
+#include "cli/mpi_session.hpp"
 #include "pipeline/run_loop.hpp"
 #include "scene/simulate_scene.hpp"
 #include "core/atomic_file.hpp"
 #include "core/log.hpp"
 #include "dem/checkpoint.hpp"
+#include "dem/distributed.hpp"
 #include "dem/io.hpp"
 
 namespace app {
@@ -25,18 +27,22 @@ int run_simulate(const SimulateCommand& c) {
   const fs::path dir = scene.output.directory;
   fs::create_directories(dir);
   const dem::Model model = dem::compile_model(scene.spec, scene.state, scene.source);
-  dem::State state = std::move(scene.state);
+  const std::size_t grains = scene.state.size();
+  // Under mpirun every rank reads the scene and keeps its share; rank 0 writes the outputs.
+  const std::shared_ptr<dem::Exchange> ranks = mpi_exchange();
+  const bool root = !ranks || ranks->rank() == 0;
+  dem::State state = dem::share_of(std::move(scene.state), ranks);
   const fs::path checkpoint = dir / "checkpoint.bin";
   if (c.resume) {
-    state = dem::read_checkpoint(model, checkpoint);
+    state = dem::read_checkpoint(model, checkpoint, ranks);
   } else {
     dem::initialize(model, state);
   }
   diefill::log::info("{}: {} grains, time step {:.3g} s (Rayleigh {:.3g} s, collision {:.3g} s), skin {:.3g} m",
-                     scene.source, state.size(), model.dt, model.dt_rayleigh, model.dt_hertz, model.skin);
+                     scene.source, grains, model.dt, model.dt_rayleigh, model.dt_hertz, model.skin);
 
   std::unique_ptr<dem::TrajectoryWriter> trajectory;
-  if (scene.output.trajectory) trajectory = std::make_unique<dem::TrajectoryWriter>(dir / "trajectory.csv");
+  if (scene.output.trajectory && root) trajectory = std::make_unique<dem::TrajectoryWriter>(dir / "trajectory.csv");
   int snapshot = 0;
   double next_snapshot = scene.output.snapshot_every > 0 ? state.time : std::numeric_limits<double>::infinity();
   LoopOptions loop;
@@ -47,25 +53,31 @@ int run_simulate(const SimulateCommand& c) {
   if (scene.output.trajectory && scene.output.snapshot_every > 0)
     loop.output_every = std::min(scene.output.trajectory_every, scene.output.snapshot_every);
   loop.output = [&](const dem::State& s) {
-    if (trajectory) trajectory->write(s);
-    if (s.time >= next_snapshot - 0.5 * model.dt) {
-      dem::write_vtu(s, dir / fmt::format("snapshot_{:05d}.vtu", snapshot++));
-      next_snapshot += scene.output.snapshot_every;
-    }
+    const bool snapshot_due = s.time >= next_snapshot - 0.5 * model.dt;
+    if (snapshot_due) next_snapshot += scene.output.snapshot_every;
+    if (!scene.output.trajectory && !snapshot_due) return;
+    dem::with_whole_state(s, [&](const dem::State& whole) {
+      if (trajectory) trajectory->write(whole);
+      if (snapshot_due) dem::write_vtu(whole, dir / fmt::format("snapshot_{:05d}.vtu", snapshot++));
+    });
   };
   install_interrupt_handler();
   const LoopResult result = run_until(model, state, loop);
-  dem::write_particles_csv(state, dir / "particles.csv");
+  const std::int64_t lost = ranks ? ranks->sum(state.lost) : state.lost;
+  dem::with_whole_state(state, [&](const dem::State& whole) { dem::write_particles_csv(whole, dir / "particles.csv"); });
+  if (!root) return result.interrupted ? diefill::exit_interrupted : diefill::exit_ok;
   const nlohmann::json summary = {
-      {"grains", state.size()},
-      {"lost", state.lost},
+      {"grains", grains},
+      {"lost", lost},
       {"time_s", state.time},
       {"steps", state.step},
       {"dt_s", model.dt},
       {"interrupted", result.interrupted},
       {"timing",
        {{"wall_s", result.wall_s},
-        {"particle_steps_per_s", double(result.steps) * double(state.size()) / std::max(1e-9, result.wall_s)},
+        {"particle_steps_per_s", double(result.steps) * double(grains) / std::max(1e-9, result.wall_s)},
+        {"ranks", ranks ? ranks->ranks() : 1},
+        {"threads_per_rank", omp_get_max_threads()},
         {"stages", stage_times_json(result.times)}}},
       {"stability", {{"max_overlap_rel", result.max_overlap_rel}, {"max_energy_gain", result.max_energy_gain}}}};
   diefill::write_file_atomic(dir / "summary.json", summary.dump(2) + "\n");
@@ -74,7 +86,7 @@ int run_simulate(const SimulateCommand& c) {
                checkpoint.string());
     return diefill::exit_interrupted;
   }
-  fmt::print("{}: {} grains to t = {:.6g} s in {} steps -> {}\n", scene.source, state.size(), state.time,
+  fmt::print("{}: {} grains to t = {:.6g} s in {} steps -> {}\n", scene.source, grains, state.time,
              result.steps, dir.string());
   return 0;
 }

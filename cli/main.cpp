@@ -160,21 +160,29 @@ int main(int argc, char** argv) {
     const int status = root.exit(e);
     return status == 0 ? 0 : diefill::exit_bad_input;
   }
-  if (const auto ranks = app::mpi_exchange(); ranks && ranks->ranks() > 1 && !root.got_subcommand("bench")) {
-    fmt::print(stderr, "error: mpirun: only `diefill bench` is split over MPI ranks so far; run the other commands "
-                       "without mpirun (they use every core through threads)\n");
+  const std::shared_ptr<dem::Exchange> ranks = app::mpi_exchange();
+  const bool split = ranks && ranks->ranks() > 1;
+  if (split && !root.got_subcommand("run") && !root.got_subcommand("simulate") && !root.got_subcommand("bench")) {
+    if (ranks->rank() == 0)
+      fmt::print(stderr, "error: mpirun: only `diefill run`, `simulate` and `bench` are split over MPI ranks; run the other "
+                         "commands without mpirun (they use every core through threads)\n");
     return diefill::exit_bad_input;
   }
+  // Split over ranks, input and stability errors arise on every rank together (the ranks decide
+  // them collectively): rank 0 says them. Any other error is one rank's, and the others would wait
+  // for it forever: it stops them all.
+  const bool says = !split || ranks->rank() == 0;
   try {
     return action ? action() : diefill::exit_ok;
   } catch (const diefill::InputError& e) {
-    fmt::print(stderr, "error: {}\n", e.what());
+    if (says) fmt::print(stderr, "error: {}\n", e.what());
     return diefill::exit_bad_input;
   } catch (const diefill::StabilityError& e) {
-    fmt::print(stderr, "stopped: {}\n", e.what());
+    if (says) fmt::print(stderr, "stopped: {}\n", e.what());
     return diefill::exit_unstable;
   } catch (const std::exception& e) {
     fmt::print(stderr, "error: {}\n", e.what());
+    if (split) app::abort_all_ranks(diefill::exit_other);
     return diefill::exit_other;
   }
 }

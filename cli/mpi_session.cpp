@@ -35,6 +35,10 @@ MpiSession::~MpiSession() {
   session_exchange.reset();
   MPI_Finalize();
 }
+void abort_all_ranks(int status) {
+  MPI_Abort(MPI_COMM_WORLD, status);
+  std::exit(status);  // MPI_Abort does not return; the compiler cannot know
+}
 #else
 MpiSession::MpiSession(int&, char**&) {
   if (std::getenv("OMPI_COMM_WORLD_SIZE"))
@@ -42,6 +46,7 @@ MpiSession::MpiSession(int&, char**&) {
                        "(install libopenmpi-dev and rebuild)");
 }
 MpiSession::~MpiSession() = default;
+void abort_all_ranks(int status) { std::exit(status); }
 #endif
 
 std::shared_ptr<dem::Exchange> mpi_exchange() { return session_exchange; }

@@ -19,4 +19,7 @@ class MpiSession {
 // The exchange of this run's ranks; null on one process without mpirun.
 std::shared_ptr<dem::Exchange> mpi_exchange();
 
+// Ends every rank of the run with `status` (an error on one rank that the others cannot know of).
+[[noreturn]] void abort_all_ranks(int status);
+
 }  // namespace app

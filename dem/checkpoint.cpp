@@ -1,15 +1,19 @@
 #include "dem/checkpoint.hpp"
 
+#include <algorithm>
 #include <fstream>
+#include <unordered_map>
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "dem/distributed.hpp"
 
 namespace dem {
 
 namespace {
 
 constexpr char magic[8] = {'D', 'F', 'C', 'K', 'P', 'T', '0', '4'};
+constexpr char split_magic[8] = {'D', 'F', 'C', 'K', 'S', 'P', '0', '1'};
 
 struct Writer {
   std::string bytes;
@@ -93,30 +97,153 @@ void fields(IO& io, S& s) {
   io.value(s.energy_reference_set);
 }
 
-}  // namespace
+// A run split over ranks, as one rank-count-free image: grains in id order with the forces of the
+// last step (the next step's first half kick needs them), their wall contacts and pair histories
+// keyed by global ids. Its lists are not kept: the first step after it builds them, and carries
+// the histories into them by id.
+struct CheckpointGrain {
+  GrainRecord grain;
+  Vec3 f, torque;
+};
+struct SlotRecord {
+  std::int64_t id;
+  WallSlot slot[wall_slots_per_particle];
+};
+struct SplitImage {
+  double time = 0, wall_work = 0, energy_reference = 0, energy_scale = 0;
+  std::int64_t step = 0, lost = 0;
+  std::uint8_t energy_reference_set = 0;
+  std::vector<CheckpointGrain> grains;
+  std::vector<SlotRecord> slots;
+  std::vector<CarriedPair> pairs;
+};
 
-void write_checkpoint(const Model& model, const State& state, const std::filesystem::path& path) {
-  Writer w;
-  w.bytes.append(magic, sizeof magic);
-  w.bytes.append(model.hash);
-  fields(w, state);
-  diefill::write_file_atomic(path, w.bytes);
+template <typename IO, typename I>
+void split_fields(IO& io, I& image) {
+  io.value(image.time);
+  io.value(image.wall_work);
+  io.value(image.energy_reference);
+  io.value(image.energy_scale);
+  io.value(image.step);
+  io.value(image.lost);
+  io.value(image.energy_reference_set);
+  io.array(image.grains);
+  io.array(image.slots);
+  io.array(image.pairs);
 }
 
-State read_checkpoint(const Model& model, const std::filesystem::path& path) {
-  Reader r{std::ifstream(path, std::ios::binary)};
+// The owned grains' share of the image, as bytes for rank 0.
+void put_owned(const State& s, std::vector<char>& grains, std::vector<char>& slots, std::vector<char>& pairs) {
+  for (std::size_t i = 0; i < s.owned(); ++i) put(grains, CheckpointGrain{grain_record(s, i), s.f[i], s.torque[i]});
+  const NeighbourList& nl = s.neighbours;
+  if (s.wall_slots.size() == nl.near_wall.size() * wall_slots_per_particle)
+    for (std::size_t q = 0; q < nl.near_wall.size(); ++q) {
+      SlotRecord r{s.id[std::size_t(nl.near_wall[q])], {}};
+      std::copy_n(&s.wall_slots[q * wall_slots_per_particle], wall_slots_per_particle, r.slot);
+      put(slots, r);
+    }
+  for (const auto& of_grain : contact_histories(s))
+    for (const CarriedPair& c : of_grain) put(pairs, c);
+}
+
+template <typename T>
+std::vector<T> records(const std::vector<char>& bytes) {
+  std::vector<T> out;
+  out.reserve(bytes.size() / sizeof(T));
+  for (const char* at = bytes.data(); at < bytes.data() + bytes.size();) out.push_back(take<T>(at));
+  return out;
+}
+
+// Collective on a split state; the image is complete on rank 0 (or a single process) only.
+SplitImage image_of(const State& s) {
+  SplitImage image;
+  image.time = s.time, image.wall_work = s.wall_work, image.step = s.step;
+  image.energy_reference = s.energy_reference, image.energy_scale = s.energy_scale;
+  image.energy_reference_set = s.energy_reference_set;
+  image.lost = s.exchange ? s.exchange->sum(s.lost) : s.lost;
+  std::vector<char> grains, slots, pairs;
+  put_owned(s, grains, slots, pairs);
+  if (s.exchange) grains = s.exchange->gather(grains), slots = s.exchange->gather(slots), pairs = s.exchange->gather(pairs);
+  image.grains = records<CheckpointGrain>(grains);
+  image.slots = records<SlotRecord>(slots);
+  image.pairs = records<CarriedPair>(pairs);
+  // In id order, so that the file is the same whichever rank held which grain.
+  std::sort(image.grains.begin(), image.grains.end(), [](const auto& a, const auto& b) { return a.grain.id < b.grain.id; });
+  std::sort(image.slots.begin(), image.slots.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
+  std::sort(image.pairs.begin(), image.pairs.end(),
+            [](const auto& a, const auto& b) { return a.id != b.id ? a.id < b.id : a.partner < b.partner; });
+  return image;
+}
+
+// This rank's share of the image (every ranks-th grain, as share_of), ready to step.
+State share_of_image(const SplitImage& image, std::shared_ptr<Exchange> exchange) {
+  State s;
+  std::unordered_map<std::int64_t, std::size_t> index;
+  for (std::size_t k = std::size_t(exchange->rank()); k < image.grains.size(); k += std::size_t(exchange->ranks())) {
+    const CheckpointGrain& g = image.grains[k];
+    index.emplace(g.grain.id, s.size());
+    append_grain(s, g.grain);
+    s.f.back() = g.f, s.torque.back() = g.torque;
+  }
+  for (const SlotRecord& r : image.slots)
+    if (const auto at = index.find(r.id); at != index.end()) {
+      s.neighbours.near_wall.push_back(std::int32_t(at->second));
+      s.wall_slots.insert(s.wall_slots.end(), r.slot, r.slot + wall_slots_per_particle);
+    }
+  for (const CarriedPair& c : image.pairs)
+    if (index.count(c.id)) s.carried_pairs.push_back(c);
+  s.time = image.time, s.step = image.step, s.wall_work = image.wall_work;
+  s.lost = exchange->rank() == 0 ? image.lost : 0;
+  s.energy_reference = image.energy_reference, s.energy_scale = image.energy_scale;
+  s.energy_reference_set = image.energy_reference_set != 0;
+  s.exchange = std::move(exchange);
+  return s;
+}
+
+std::string read_head(Reader& r, const Model& model, const std::filesystem::path& path) {
   char head[sizeof magic];
   std::string hash(model.hash.size(), '\0');
   r.in.read(head, sizeof head);
   r.in.read(hash.data(), std::streamsize(hash.size()));
-  if (!r.in || std::string(head, sizeof head) != std::string(magic, sizeof magic))
+  const std::string kind(head, sizeof head);
+  if (!r.in || (kind != std::string(magic, sizeof magic) && kind != std::string(split_magic, sizeof split_magic)))
     throw diefill::InputError(path.string(), "", "not a diefill checkpoint", "Name a checkpoint file diefill wrote");
   if (hash != model.hash)
     throw diefill::InputError(path.string(), "model", "the checkpoint was written by a different scene or build",
                               "Resume with the scene that wrote it, or start afresh");
+  return kind;
+}
+
+}  // namespace
+
+void write_checkpoint(const Model& model, const State& state, const std::filesystem::path& path) {
+  Writer w;
+  if (state.exchange) {
+    SplitImage image = image_of(state);
+    if (!writes_outputs(state)) return;
+    w.bytes.append(split_magic, sizeof split_magic);
+    w.bytes.append(model.hash);
+    split_fields(w, image);
+  } else {
+    w.bytes.append(magic, sizeof magic);
+    w.bytes.append(model.hash);
+    fields(w, state);
+  }
+  diefill::write_file_atomic(path, w.bytes);
+}
+
+State read_checkpoint(const Model& model, const std::filesystem::path& path, std::shared_ptr<Exchange> exchange) {
+  Reader r{std::ifstream(path, std::ios::binary)};
+  const bool split = read_head(r, model, path) == std::string(split_magic, sizeof split_magic);
+  if (split && !exchange)
+    throw diefill::InputError(path.string(), "", "the checkpoint was written by a run split over MPI ranks",
+                              "Resume it under mpirun, on any number of ranks (`mpirun -np 1` too)");
   State s;
-  fields(r, s);
+  SplitImage image;
+  if (split) split_fields(r, image);
+  else fields(r, s);
   if (!r.in) throw diefill::InputError(path.string(), "", "the checkpoint is truncated", "Start afresh");
+  if (exchange) return share_of_image(split ? image : image_of(s), std::move(exchange));
   // The cross pairs' force buffers are scratch, refilled by the next force stage.
   s.cross_forces.force.assign(s.neighbours.cross_reverse.size(), Vec3::Zero());
   s.cross_forces.torque.assign(s.neighbours.cross_reverse.size(), Vec3::Zero());

@@ -6,6 +6,8 @@
 // (dem/mpi_exchange.cpp) is a library of its own, so that the DEM itself links no MPI.
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
+#include <type_traits>
 #include <vector>
 
 #include "dem/types.hpp"
@@ -22,6 +24,31 @@ struct CarriedPair {
   Vec3 tangential, rolling;
 };
 
+// A grain as it travels between ranks (a ghost's copy, or a grain gathered for the outputs).
+struct GrainRecord {
+  std::int64_t id;
+  Vec3 x, v, w;
+  double radius, mass, inertia;
+  std::int32_t material;
+  std::uint8_t active;
+};
+
+// Byte buffers of plain records. The records hold numbers and Eigen's fixed-size vectors, which
+// are arrays of doubles: copied as bytes, whatever Eigen declares.
+template <typename T>
+void put(std::vector<char>& buffer, const T& value) {
+  static_assert(std::is_standard_layout_v<T>);
+  const char* bytes = reinterpret_cast<const char*>(&value);
+  buffer.insert(buffer.end(), bytes, bytes + sizeof(T));
+}
+template <typename T>
+T take(const char*& at) {
+  T value;
+  std::memcpy(static_cast<void*>(&value), at, sizeof(T));
+  at += sizeof(T);
+  return value;
+}
+
 class Exchange {
  public:
   virtual ~Exchange() = default;
@@ -32,6 +59,9 @@ class Exchange {
   virtual double max(double local) = 0;
   virtual double sum(double local) = 0;
   virtual std::int64_t sum(std::int64_t local) = 0;
+  // Every rank's bytes, concatenated in rank order, on rank 0 (empty elsewhere).
+  virtual std::vector<char> gather(const std::vector<char>& local) = 0;
+  virtual void barrier() = 0;
   // At a neighbour rebuild: owned grains move to the rank whose subdomain holds them (cut anew
   // when the heaviest rank carries more than 1.2 times the mean work), with their pair contact
   // histories (left in state.carried_pairs, keyed by global ids) and their wall contacts; then

@@ -118,13 +118,11 @@ Model compile_model(const ModelSpec& spec, const State& state, const std::string
   // Time step: a fraction of the smaller of the Rayleigh time and the collision time at the
   // highest expected impact speed, over the grains present.
   m.max_radius = 0;
-  double min_radius = std::numeric_limits<double>::infinity();
   m.dt_rayleigh = std::numeric_limits<double>::infinity();
   m.dt_hertz = std::numeric_limits<double>::infinity();
   std::map<std::pair<int, double>, bool> seen;
   for (std::size_t i = 0; i < state.size(); ++i) {
     m.max_radius = std::max(m.max_radius, state.radius[i]);
-    min_radius = std::min(min_radius, state.radius[i]);
     if (!seen.emplace(std::pair{state.material[i], state.radius[i]}, true).second) continue;
     const Material& mat = m.materials[std::size_t(state.material[i])];
     m.dt_rayleigh = std::min(m.dt_rayleigh, rayleigh_time(mat, state.radius[i]));
@@ -139,6 +137,12 @@ Model compile_model(const ModelSpec& spec, const State& state, const std::string
         m.dt_hertz = std::min(m.dt_hertz, std::numbers::pi * std::sqrt(0.5 * mass / p.k_linear));
       }
     }
+  }
+  // Split over ranks, each holds some of the grains: the time step is the whole scene's.
+  if (state.exchange) {
+    m.max_radius = state.exchange->max(m.max_radius);
+    m.dt_rayleigh = -state.exchange->max(-m.dt_rayleigh);
+    m.dt_hertz = -state.exchange->max(-m.dt_hertz);
   }
   const double stable = std::min(m.dt_rayleigh, m.dt_hertz);
   if (spec.time_step) {

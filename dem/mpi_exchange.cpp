@@ -8,6 +8,7 @@
 #include <type_traits>
 
 #include "core/error.hpp"
+#include "dem/distributed.hpp"
 #include "dem/model.hpp"
 #include "dem/state.hpp"
 
@@ -15,38 +16,13 @@ namespace dem {
 
 namespace {
 
-// Byte buffers of plain records, one per destination rank. The records hold numbers and Eigen's
-// fixed-size vectors, which are arrays of doubles: copied as bytes, whatever Eigen declares.
-template <typename T>
-void put(std::vector<char>& buffer, const T& value) {
-  static_assert(std::is_standard_layout_v<T>);
-  const char* bytes = reinterpret_cast<const char*>(&value);
-  buffer.insert(buffer.end(), bytes, bytes + sizeof(T));
-}
-template <typename T>
-T take(const char*& at) {
-  T value;
-  std::memcpy(static_cast<void*>(&value), at, sizeof(T));
-  at += sizeof(T);
-  return value;
-}
-
 // A grain moving to another rank; its K wall slots (when near a wall) and `pairs` histories follow.
 struct Migrant {
-  std::int64_t id;
-  Vec3 x, v, w;
-  double radius, mass, inertia;
-  std::int32_t material, pairs;
-  std::uint8_t active, near_wall;
+  GrainRecord grain;
+  std::int32_t pairs;
+  std::uint8_t near_wall;
 };
-// A ghost's copy at a rebuild, and its motion every step after.
-struct GhostCopy {
-  std::int64_t id;
-  Vec3 x, v, w;
-  double radius, mass, inertia;
-  std::int32_t material;
-  std::uint8_t active;
-};
+// A ghost's motion every step after the rebuild that sent its copy (a GrainRecord).
 struct GhostMotion {
   Vec3 x, v, w;
 };
@@ -70,26 +46,6 @@ struct Box {
     return (lo - p).cwiseMax(p - hi).cwiseMax(0.0).norm();
   }
 };
-
-void append_grain(State& s, std::int64_t id, const Vec3& x, const Vec3& v, const Vec3& w, double radius, double mass,
-                  double inertia, std::int32_t material, std::uint8_t active) {
-  s.id.push_back(id), s.x.push_back(x), s.v.push_back(v), s.w.push_back(w);
-  s.f.push_back(Vec3::Zero()), s.torque.push_back(Vec3::Zero());
-  s.radius.push_back(radius), s.mass.push_back(mass), s.inertia.push_back(inertia);
-  s.material.push_back(material), s.active.push_back(active), s.body.push_back(-1);
-}
-
-// Keeps the grains listed in `keep`, in that order.
-void keep_grains(State& s, const std::vector<std::size_t>& keep) {
-  const auto select = [&](auto& a) {
-    std::remove_reference_t<decltype(a)> kept;
-    kept.reserve(keep.size());
-    for (std::size_t i : keep) kept.push_back(a[i]);
-    a.swap(kept);
-  };
-  select(s.id), select(s.x), select(s.v), select(s.w), select(s.f), select(s.torque);
-  select(s.radius), select(s.mass), select(s.inertia), select(s.material), select(s.active), select(s.body);
-}
 
 class MpiExchange final : public Exchange {
  public:
@@ -116,6 +72,8 @@ class MpiExchange final : public Exchange {
     MPI_Allreduce(&local, &global, 1, MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD);
     return global;
   }
+  std::vector<char> gather(const std::vector<char>& local) override;
+  void barrier() override { MPI_Barrier(MPI_COMM_WORLD); }
   void redistribute(const Model& model, State& s) override;
   void reordered(const std::vector<std::int32_t>& new_index) override {
     for (auto& list : send_)
@@ -164,6 +122,16 @@ std::vector<char> MpiExchange::all_to_all(const std::vector<std::vector<char>>& 
   MPI_Alltoallv(sending.data(), send_counts.data(), send_at.data(), MPI_BYTE, received.data(), receive_counts.data(),
                 receive_at.data(), MPI_BYTE, MPI_COMM_WORLD);
   return received;
+}
+
+std::vector<char> MpiExchange::gather(const std::vector<char>& local) {
+  const int bytes = int(local.size());
+  std::vector<int> counts(static_cast<std::size_t>(ranks_)), at(static_cast<std::size_t>(ranks_), 0);
+  MPI_Gather(&bytes, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
+  for (std::size_t r = 1; r < std::size_t(ranks_); ++r) at[r] = at[r - 1] + counts[r - 1];
+  std::vector<char> all(rank_ == 0 ? std::size_t(at.back() + counts.back()) : 0);
+  MPI_Gatherv(local.data(), bytes, MPI_BYTE, all.data(), counts.data(), at.data(), MPI_BYTE, 0, MPI_COMM_WORLD);
+  return all;
 }
 
 // Recursive coordinate bisection of every rank's grains, computed alike on every rank from the
@@ -231,25 +199,12 @@ void MpiExchange::migrate(State& s) {
   const NeighbourList& nl = s.neighbours;
   const bool listed = nl.row_start.size() == s.size() + 1;
   // What each owned grain takes along: its pairs' histories (as it sees them), its wall contacts.
-  // A pair of two grains of this rank goes with both, as either may leave: a grain that took
-  // none to a rank where its partner is a ghost would start the pair afresh there, while the
-  // partner's rank kept the spring (the pair's two forces then differ, and momentum drifts).
-  std::vector<std::vector<CarriedPair>> pairs_of(owned);
+  const std::vector<std::vector<CarriedPair>> pairs_of = contact_histories(s);
   std::vector<const WallSlot*> slots_of(owned, nullptr);
   std::vector<WeightedPoint> points;
-  for (std::size_t i = 0; i < owned; ++i) {
-    if (listed)
-      for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p) {
-        const Vec3 t = nl.tangential.empty() ? Vec3::Zero() : nl.tangential[std::size_t(p)];
-        const Vec3 r = nl.rolling.empty() ? Vec3::Zero() : nl.rolling[std::size_t(p)];
-        if (t.squaredNorm() == 0 && r.squaredNorm() == 0) continue;
-        const std::size_t j = std::size_t(nl.partner[std::size_t(p)]);
-        pairs_of[i].push_back({s.id[i], s.id[j], t, r});
-        if (j < owned) pairs_of[j].push_back({s.id[j], s.id[i], -t, -r});
-      }
-    // The cost of a grain: its listed pairs, and itself.
+  // The cost of a grain: its listed pairs, and itself.
+  for (std::size_t i = 0; i < owned; ++i)
     if (s.active[i]) points.push_back({s.x[i], 1.0 + (listed ? double(nl.row_start[i + 1] - nl.row_start[i]) : 0.0), s.id[i]});
-  }
   if (s.wall_slots.size() == nl.near_wall.size() * wall_slots_per_particle)
     for (std::size_t q = 0; q < nl.near_wall.size(); ++q) slots_of[std::size_t(nl.near_wall[q])] = &s.wall_slots[q * wall_slots_per_particle];
 
@@ -280,8 +235,7 @@ void MpiExchange::migrate(State& s) {
       continue;
     }
     std::vector<char>& b = out[std::size_t(to)];
-    put(b, Migrant{s.id[i], s.x[i], s.v[i], s.w[i], s.radius[i], s.mass[i], s.inertia[i], s.material[i],
-                   std::int32_t(pairs_of[i].size()), s.active[i], std::uint8_t(slots_of[i] ? 1 : 0)});
+    put(b, Migrant{grain_record(s, i), std::int32_t(pairs_of[i].size()), std::uint8_t(slots_of[i] ? 1 : 0)});
     if (slots_of[i])
       for (int k = 0; k < wall_slots_per_particle; ++k) put(b, slots_of[i][k]);
     for (const CarriedPair& c : pairs_of[i]) put(b, c);
@@ -290,7 +244,7 @@ void MpiExchange::migrate(State& s) {
   keep_grains(s, keep);
   for (const char* at = received.data(); at < received.data() + received.size();) {
     const Migrant m = take<Migrant>(at);
-    append_grain(s, m.id, m.x, m.v, m.w, m.radius, m.mass, m.inertia, m.material, m.active);
+    append_grain(s, m.grain);
     if (m.near_wall) {
       near.push_back(std::int32_t(s.size() - 1));
       for (int k = 0; k < wall_slots_per_particle; ++k) slots.push_back(take<WallSlot>(at));
@@ -316,13 +270,12 @@ void MpiExchange::send_ghosts(const Model& model, State& s) {
     for (int r = 0; r < ranks_; ++r)
       if (r != rank_ && boxes_[std::size_t(r)].distance(s.x[i]) < reach) {
         send_[std::size_t(r)].push_back(std::int32_t(i));
-        put(out[std::size_t(r)], GhostCopy{s.id[i], s.x[i], s.v[i], s.w[i], s.radius[i], s.mass[i], s.inertia[i], s.material[i], s.active[i]});
+        put(out[std::size_t(r)], grain_record(s, i));
       }
   }
   const std::vector<char> received = all_to_all(out);
   for (const char* at = received.data(); at < received.data() + received.size(); ++s.ghosts) {
-    const GhostCopy g = take<GhostCopy>(at);
-    append_grain(s, g.id, g.x, g.v, g.w, g.radius, g.mass, g.inertia, g.material, g.active);
+    append_grain(s, take<GrainRecord>(at));
   }
 }
 

@@ -2,6 +2,7 @@
 
 #include <omp.h>
 
+#include "core/error.hpp"
 #include "core/timer.hpp"
 #include "pipeline/census.hpp"
 #include "pipeline/outputs.hpp"
@@ -31,20 +32,40 @@ class ThreadCount {
   int saved_;
 };
 
+// Split over ranks, rank 0 prepares the walls first (building the fields into the cache) and the
+// others then read them from it; a failure there stops every rank.
+FillWalls walls_rank0_first(const PipelineScene& s, const DieSource& source, const GrainSizing& grains, const ShoePlan& shoe,
+                            const std::shared_ptr<dem::Exchange>& ranks) {
+  if (!ranks || ranks->ranks() == 1) return prepare_walls(s, source, grains, shoe);
+  if (ranks->rank() == 0) {
+    try {
+      FillWalls walls = prepare_walls(s, source, grains, shoe);
+      ranks->max(0.0);
+      return walls;
+    } catch (...) {
+      ranks->max(1.0);
+      throw;
+    }
+  }
+  if (ranks->max(0.0) > 0)
+    throw diefill::InputError(source.file.source, "", "rank 0 could not prepare the walls", "See rank 0's message");
+  return prepare_walls(s, source, grains, shoe);
+}
+
 }  // namespace
 
-DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resume) {
+DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resume, const std::shared_ptr<dem::Exchange>& ranks) {
   diefill::Stopwatch clock;
   const ThreadCount threads(s.threads);
   const DieSource source = read_die(s, die_mesh);
   ShoePlan shoe = plan_shoe(s, source);
   const GrainSizing grains = size_grains(s, shoe, source.file.name);
   set_clearance(s, grains, source.table_z, shoe);
-  const FillWalls walls = prepare_walls(s, source, grains, shoe);
+  const FillWalls walls = walls_rank0_first(s, source, grains, shoe, ranks);
   DieRun run{walls.die.name, {}, s.out / walls.die.name, false};
   fs::create_directories(run.dir);
 
-  const std::optional<SettledShoe> settled = fill_and_settle_shoe(s, walls, grains, shoe, source.table_z);
+  const std::optional<SettledShoe> settled = fill_and_settle_shoe(s, walls, grains, shoe, source.table_z, ranks);
   if (!settled) {
     run.interrupted = true;
     return run;
@@ -54,10 +75,12 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
     run.interrupted = true;
     return run;
   }
+  if (ranks && ranks->rank() != 0) return run;  // rank 0 counts and writes
 
   const Census census = count_grains(fill->state, source.table_z, shoe);
   check_losses(census, source.file.source, walls.die.name);
-  run.report = write_fill_outputs({s, walls, grains, shoe, *settled, *fill, census, source.table_z, clock.seconds()}, run.dir);
+  const FillRecord record{s, walls, grains, shoe, *settled, *fill, census, source.table_z, clock.seconds(), ranks ? ranks->ranks() : 1};
+  run.report = write_fill_outputs(record, run.dir);
   return run;
 }
 

@@ -4,9 +4,11 @@
 // shoe (cached), move it over the die and let the die settle, count every grain, and write the
 // density field, the report and the pictures into OUT/<die name>/ (docs/INTERFACE.md).
 #include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "dem/exchange.hpp"
 #include "scene/pipeline_scene.hpp"
 
 namespace app {
@@ -19,6 +21,9 @@ struct DieRun {
 };
 
 // Throws InputError for bad input and StabilityError when the run stops on a stability check.
-DieRun run_die_fill(const PipelineScene& scene, const std::filesystem::path& die_mesh, bool resume);
+// Split over MPI ranks (every rank calls it with the session's exchange), rank 0 writes the
+// outputs and returns the report; the others return an empty one.
+DieRun run_die_fill(const PipelineScene& scene, const std::filesystem::path& die_mesh, bool resume,
+                    const std::shared_ptr<dem::Exchange>& ranks = nullptr);
 
 }  // namespace app

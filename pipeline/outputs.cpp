@@ -1,6 +1,7 @@
 #include "pipeline/outputs.hpp"
 
 #include <fmt/core.h>
+#include <omp.h>
 
 #include "core/atomic_file.hpp"
 #include "core/log.hpp"
@@ -68,6 +69,8 @@ nlohmann::json report_json(const FillRecord& r, const nlohmann::json& fill) {
         {"steps", r.fill.loop.steps},
         {"dt_s", r.fill.dt},
         {"particle_steps_per_s", steps * double(r.fill.state.size()) / std::max(1e-9, r.fill.loop.wall_s)},
+        {"ranks", r.ranks},
+        {"threads_per_rank", omp_get_max_threads()},
         {"stages", stage_times_json(r.fill.loop.times)}}},
       {"final_state_sha256", dem::state_hash(r.fill.state)},
       {"stability",

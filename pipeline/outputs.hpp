@@ -22,6 +22,7 @@ struct FillRecord {
   const Census& census;
   double table_z;
   double wall_s;  // the whole run's wall-clock time so far
+  int ranks;      // MPI ranks the run was split over (1: one process)
 };
 
 // Writes every output into `dir` (staged: a failure keeps the earlier outputs); returns the report.

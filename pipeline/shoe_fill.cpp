@@ -7,8 +7,10 @@
 #include <filesystem>
 #include <numbers>
 
+#include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/sha256.hpp"
+#include "dem/distributed.hpp"
 #include "dem/insert.hpp"
 #include "dem/io.hpp"
 #include "dem/step.hpp"
@@ -36,35 +38,49 @@ struct Insertion {
   const ShoePlan& shoe;
   double table_z;
   std::optional<mesh::ClumpTemplate> clump;
+  std::shared_ptr<dem::Exchange> ranks;  // null: one process
 };
+
+// The powder already in the shoe, over every rank of a split run.
+struct Bed {
+  double top;             // its highest point (the table when empty) [m]
+  std::int64_t grains;
+  std::int64_t next_id;   // the first id not taken
+};
+
+Bed bed_of(const Insertion& in, const dem::State& bed) {
+  Bed b{in.table_z, std::int64_t(bed.owned()), 0};
+  for (std::size_t i = 0; i < bed.owned(); ++i)
+    b.top = std::max(b.top, bed.x[i].z() + bed.radius[i]), b.next_id = std::max(b.next_id, bed.id[i] + 1);
+  if (bed.exchange)
+    b = {bed.exchange->max(b.top), bed.exchange->sum(b.grains), std::int64_t(bed.exchange->max(double(b.next_id)))};
+  return b;
+}
 
 // The box above the powder already in the shoe (from the table at first), inside its walls, as
 // high as `count` more grains need at the jamming fraction of random insertion (about 0.38 of
 // the poured 0.6): grains dropped from no higher than that cannot be thrown out of the shoe.
-dem::InsertRegion space_above_bed(const Insertion& in, const dem::State& bed, std::size_t count) {
+dem::InsertRegion space_above_bed(const Insertion& in, const Bed& bed, std::size_t count) {
   const double inset = in.grains.r_max + 1e-6;
-  double floor = in.table_z;
-  for (std::size_t i = 0; i < bed.size(); ++i) floor = std::max(floor, bed.x[i].z() + bed.radius[i]);
-  const double bed_height = bed.size() == 0 ? in.scene.fill_height
+  const double bed_height = bed.grains == 0 ? in.scene.fill_height
                                             : double(count) * std::numbers::pi / 6 * std::pow(in.grains.diameter, 3) /
                                                   (0.6 * in.shoe.length * in.shoe.width);
-  const double top = std::min(in.table_z + in.scene.shoe_height - inset,
-                              (bed.size() == 0 ? in.table_z : floor) + bed_height * 0.6 / 0.38 + 2 * in.grains.r_max);
+  const double top = std::min(in.table_z + in.scene.shoe_height - inset, bed.top + bed_height * 0.6 / 0.38 + 2 * in.grains.r_max);
   dem::InsertRegion region;
-  region.box = {Vec3(in.shoe.x_start - 0.5 * in.shoe.length + inset, in.shoe.y_centre - 0.5 * in.shoe.width + inset, floor + inset),
+  region.box = {Vec3(in.shoe.x_start - 0.5 * in.shoe.length + inset, in.shoe.y_centre - 0.5 * in.shoe.width + inset, bed.top + inset),
                 Vec3(in.shoe.x_start + 0.5 * in.shoe.length - inset, in.shoe.y_centre + 0.5 * in.shoe.width - inset, top)};
   return region;
 }
 
 std::size_t insert_round(const Insertion& in, dem::State& bed, std::size_t count, int round) {
-  const dem::InsertRegion region = space_above_bed(in, bed, count);
+  const Bed before = bed_of(in, bed);
+  const dem::InsertRegion region = space_above_bed(in, before, count);
   if (region.box.hi.z() <= region.box.lo.z()) return 0;
   const std::uint64_t seed = in.scene.seed + std::uint64_t(round) * 7919;  // round 0: the scene's seed, as always
-  const std::int64_t first_id = bed.size() == 0 ? 0 : *std::max_element(bed.id.begin(), bed.id.end()) + 1;
   const double density = in.walls.spec.materials[std::size_t(in.walls.powder)].density;
   if (in.clump)
     return dem::insert_clumps(bed, region, *in.clump, in.grains.diameter / in.clump->equivalent_diameter_m, count,
-                              in.walls.powder, density, seed, first_id);
+                              in.walls.powder, density, seed, before.next_id);
   dem::InsertRequest request;
   request.count = count;
   request.radius = 0.5 * in.grains.diameter;
@@ -72,9 +88,15 @@ std::size_t insert_round(const Insertion& in, dem::State& bed, std::size_t count
   request.material = in.walls.powder;
   request.density = density;
   request.seed = seed;
-  request.first_id = first_id;
+  request.first_id = before.next_id;
   request.max_solid_fraction = insertion_solid_fraction;
-  return dem::insert_spheres(bed, region, request);
+  if (!bed.exchange) return dem::insert_spheres(bed, region, request);
+  // Split over ranks, every rank draws the same new grains (the box lies above the bed, so the
+  // grains below cannot change a draw) and takes its share of them.
+  dem::State fresh;
+  const std::size_t added = dem::insert_spheres(fresh, region, request);
+  dem::add_share(bed, fresh);
+  return added;
 }
 
 // Settles the bed for shoe.settle_time at the scene's time step (the settling shoe sees no fall
@@ -94,6 +116,7 @@ bool settle(const Insertion& in, dem::State& bed, const std::string& label) {
 
 std::optional<SettledShoe> settle_afresh(const Insertion& in, const std::string& die_name) {
   SettledShoe out;
+  out.state.exchange = in.ranks;
   out.requested = in.grains.count;
   for (int round = 0; round < max_insertion_rounds && out.inserted < out.requested; ++round) {
     const std::size_t added = insert_round(in, out.state, out.requested - out.inserted, round);
@@ -132,10 +155,13 @@ std::string settled_shoe_key(const PipelineScene& s, const SettledShoeInputs& in
 }
 
 std::optional<SettledShoe> fill_and_settle_shoe(const PipelineScene& s, const FillWalls& walls, const GrainSizing& grains,
-                                                const ShoePlan& shoe, double table_z) {
-  Insertion in{s, walls, grains, shoe, table_z, std::nullopt};
+                                                const ShoePlan& shoe, double table_z, const std::shared_ptr<dem::Exchange>& ranks) {
+  Insertion in{s, walls, grains, shoe, table_z, std::nullopt, ranks};
   // Clumps are settled afresh each run: the particles file does not hold their poses.
   if (!s.shape_mesh.empty()) {
+    if (ranks && ranks->ranks() > 1)
+      throw diefill::InputError(s.source, "powder.shape", "clump grains are not split over MPI ranks yet",
+                                "Run clump grains without mpirun (on threads), or use spheres");
     in.clump = build_clump({s.shape_mesh, mesh::parse_unit(s.shape_units, "powder.shape.units"), s.shape_tolerance, 64, s.seed});
     std::optional<SettledShoe> settled = settle_afresh(in, walls.die.name);
     if (settled) rest(settled->state);
@@ -145,15 +171,18 @@ std::optional<SettledShoe> fill_and_settle_shoe(const PipelineScene& s, const Fi
   const fs::path file = walls.cache / ("shoe-" + key + ".csv");
   SettledShoe out;
   out.from_cache = fs::exists(file);
+  if (ranks) ranks->barrier();  // every rank has looked before any writes it
   if (!out.from_cache) {
     const std::optional<SettledShoe> settled = settle_afresh(in, walls.die.name);
     if (!settled) return std::nullopt;
     fs::create_directories(walls.cache);
-    dem::write_particles_csv(settled->state, file);
+    dem::with_whole_state(settled->state, [&](const dem::State& whole) { dem::write_particles_csv(whole, file); });
+    if (ranks) ranks->barrier();
   }
-  out.state = dem::read_particles_csv(file, walls.powder, walls.spec.materials[std::size_t(walls.powder)].density);
+  // Every run, cached or not, split or not, starts from the file's numbers.
+  out.state = dem::share_of(dem::read_particles_csv(file, walls.powder, walls.spec.materials[std::size_t(walls.powder)].density), ranks);
   out.requested = grains.count;
-  out.inserted = out.state.size();
+  out.inserted = std::size_t(ranks ? ranks->sum(std::int64_t(out.state.size())) : std::int64_t(out.state.size()));
   rest(out.state);
   return out;
 }

@@ -24,13 +24,14 @@ struct SettledShoeInputs {
 std::string settled_shoe_key(const PipelineScene& scene, const SettledShoeInputs& inputs, std::string_view dem_source_hash);
 
 struct SettledShoe {
-  dem::State state;            // at rest, time 0
+  dem::State state;            // at rest, time 0 (this rank's share of it, split over ranks)
   std::size_t requested = 0;   // grains for shoe.fill_height
-  std::size_t inserted = 0;
+  std::size_t inserted = 0;   // over every rank
   bool from_cache = false;
 };
-// nullopt when Ctrl-C stopped the settling (nothing is cached then).
+// nullopt when Ctrl-C stopped the settling (nothing is cached then). Split over ranks (non-null
+// `ranks`), the grains are settled split, and the state returned is this rank's share.
 std::optional<SettledShoe> fill_and_settle_shoe(const PipelineScene& scene, const FillWalls& walls, const GrainSizing& grains,
-                                                const ShoePlan& shoe, double table_z);
+                                                const ShoePlan& shoe, double table_z, const std::shared_ptr<dem::Exchange>& ranks);
 
 }  // namespace app

@@ -4,6 +4,7 @@
 
 #include "core/log.hpp"
 #include "dem/checkpoint.hpp"
+#include "dem/distributed.hpp"
 #include "dem/io.hpp"
 #include "dem/step.hpp"
 
@@ -21,7 +22,7 @@ std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& wal
   fill.dt = model.dt;
   const fs::path checkpoint = dir / "checkpoint.bin";
   if (resume && fs::exists(checkpoint)) {
-    state = dem::read_checkpoint(model, checkpoint);
+    state = dem::read_checkpoint(model, checkpoint, state.exchange);
     diefill::log::info("{}: resumed at t = {:.6g} s", walls.die.name, state.time);
   } else {
     dem::initialize(model, state);
@@ -33,17 +34,22 @@ std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& wal
   int snapshot = 0;
   if (s.snapshot_every > 0) {
     loop.output_every = s.snapshot_every;
-    loop.output = [&](const dem::State& st) { dem::write_vtu(st, dir / fmt::format("snapshot_{:05d}.vtu", snapshot++)); };
+    loop.output = [&](const dem::State& st) {
+      const fs::path file = dir / fmt::format("snapshot_{:05d}.vtu", snapshot++);
+      dem::with_whole_state(st, [&](const dem::State& whole) { dem::write_vtu(whole, file); });
+    };
   }
   loop.detail = [&](const dem::State& st) {
     std::size_t n = 0;
-    for (std::size_t i = 0; i < st.size(); ++i) n += st.active[i] && st.body[i] < 0 && st.x[i].z() < table_z;
+    for (std::size_t i = 0; i < st.owned(); ++i) n += st.active[i] && st.body[i] < 0 && st.x[i].z() < table_z;
     for (std::size_t b = 0; b < st.bodies.size(); ++b) n += st.bodies.active[b] && st.bodies.x[b].z() < table_z;
-    return fmt::format("{} grains in the cavity", n);
+    return fmt::format("{} grains in the cavity", st.exchange ? std::size_t(st.exchange->sum(std::int64_t(n))) : n);
   };
   fill.loop = run_until(model, state, loop);
   if (fill.loop.interrupted) return std::nullopt;
-  fs::remove(checkpoint);
+  if (dem::writes_outputs(state)) fs::remove(checkpoint);
+  // The outputs are written from the whole state, on rank 0 of a split run.
+  if (state.exchange) state = dem::gathered(state);
   return fill;
 }
 

@@ -11,12 +11,13 @@
 namespace app {
 
 struct FillResult {
-  dem::State state;
+  dem::State state;  // split over ranks: the whole state on rank 0, none elsewhere
   LoopResult loop;
   double dt = 0;  // [s]
 };
 
 // nullopt when Ctrl-C stopped it (a checkpoint is in `dir`); StabilityError when a check did.
+// `settled` is this rank's share when the run is split over ranks (its exchange).
 std::optional<FillResult> move_shoe(const PipelineScene& scene, const FillWalls& walls, const ShoePlan& shoe, double table_z,
                                     dem::State settled, const std::filesystem::path& dir, bool resume);
 

@@ -6,8 +6,13 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <map>
 
+#include "dem/checkpoint.hpp"
+#include "dem/distributed.hpp"
 #include "dem/insert.hpp"
 #include "dem/mpi_exchange.hpp"
 #include "dem/step.hpp"
@@ -78,15 +83,7 @@ dem::State pack(std::size_t count, double speed) {
 
 // The same scene split: every rank starts with every ranks-th grain, so that nearly all of
 // them migrate at the first build.
-dem::State split(const dem::State& whole) {
-  dem::State s;
-  for (std::size_t i = std::size_t(world_rank()); i < whole.size(); i += std::size_t(world_size())) {
-    s.add_sphere(whole.id[i], whole.x[i], whole.radius[i], 2500, whole.material[i], whole.v[i], whole.w[i]);
-    s.mass.back() = whole.mass[i], s.inertia.back() = whole.inertia[i];
-  }
-  s.exchange = dem::make_mpi_exchange();
-  return s;
-}
+dem::State split(const dem::State& whole) { return dem::share_of(whole, dem::make_mpi_exchange()); }
 
 std::map<std::int64_t, std::size_t> index_by_id(const dem::State& s) {
   std::map<std::int64_t, std::size_t> m;
@@ -125,6 +122,48 @@ void expect_every_grain_once(const dem::State& part, std::size_t count) {
   ASSERT_EQ(all.size(), count);
   std::sort(all.begin(), all.end());
   EXPECT_EQ(std::adjacent_find(all.begin(), all.end()), all.end()) << "a grain on two ranks";
+}
+
+// Every grain's force by id, on every rank.
+std::map<std::int64_t, Vec3> forces_by_id(const dem::State& part) {
+  struct IdForce {
+    std::int64_t id;
+    double f[3];
+  };
+  std::vector<IdForce> mine;
+  for (std::size_t i = 0; i < part.owned(); ++i) mine.push_back({part.id[i], {part.f[i].x(), part.f[i].y(), part.f[i].z()}});
+  const int n = int(mine.size() * sizeof(IdForce));
+  std::vector<int> counts(static_cast<std::size_t>(world_size())), at(static_cast<std::size_t>(world_size()), 0);
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
+  for (std::size_t r = 1; r < counts.size(); ++r) at[r] = at[r - 1] + counts[r - 1];
+  std::vector<IdForce> all(std::size_t(at.back() + counts.back()) / sizeof(IdForce));
+  MPI_Allgatherv(mine.data(), n, MPI_BYTE, all.data(), counts.data(), at.data(), MPI_BYTE, MPI_COMM_WORLD);
+  std::map<std::int64_t, Vec3> by_id;
+  for (const IdForce& g : all) by_id[g.id] = Vec3(g.f[0], g.f[1], g.f[2]);
+  return by_id;
+}
+
+// What a resumed run must reproduce: the kinetic energy and the mean height of the grains.
+std::pair<double, double> statistics(const dem::State& part) {
+  double z = 0;
+  for (std::size_t i = 0; i < part.owned(); ++i) z += part.x[i].z();
+  const auto grains = double(part.exchange->sum(std::int64_t(part.owned())));
+  return {part.exchange->sum(dem::kinetic_energy(part)), part.exchange->sum(z) / grains};
+}
+
+void expect_same_forces(const std::map<std::int64_t, Vec3>& a, const std::map<std::int64_t, Vec3>& b, const char* when) {
+  ASSERT_EQ(a.size(), b.size()) << when;
+  double scale = 0, worst = 0;
+  for (const auto& [id, f] : a) scale = std::max(scale, f.norm());
+  for (const auto& [id, f] : a) worst = std::max(worst, (f - b.at(id)).norm() / scale);
+  EXPECT_LT(worst, 1e-12) << when;
+}
+
+// Checkpoints of the split runs, one per rank count, where CTest keeps them
+// (tests/CMakeLists.txt runs 1, 2, 3 and 4 ranks in that order).
+std::filesystem::path checkpoint_of(int ranks) {
+  const char* dir = std::getenv("DIEFILL_MPI_CHECKPOINTS");
+  return std::filesystem::path(dir ? dir : "mpi_checkpoints") / ("lattice-" + std::to_string(ranks) + "-ranks");
 }
 
 }  // namespace
@@ -195,6 +234,60 @@ TEST(MpiSplit, TheSameRankCountGivesTheSameBits) {
     return dem::state_hash(part);
   };
   EXPECT_EQ(run(), run());
+}
+
+// A split run checkpointed at step 200 and resumed, by this rank count and by a run on one rank
+// fewer (CTest ran it just before): one step after the restart every grain's force is the
+// uninterrupted run's within 1e-12 of the largest (positions, forces and every pair's and wall
+// contact's history came back: a lost spring would change its grains' forces by its full size),
+// and 200 steps after it the kinetic energy and the mean height are the uninterrupted run's to 1e-9.
+TEST(MpiCheckpoint, AnyRankCountResumesWithTheSameForcesAndStatistics) {
+  const dem::ModelSpec spec = box_spec(true);
+  dem::State whole = compressed_lattice(18, 0.3);
+  const dem::Model model = dem::compile_model(spec, whole, "mpi");
+  dem::State part = split(whole);
+  dem::initialize(model, part);
+  for (int n = 0; n < 200; ++n) dem::step(model, part);
+  const std::filesystem::path mine = checkpoint_of(world_size());
+  if (world_rank() == 0) std::filesystem::create_directories(mine);
+  dem::write_checkpoint(model, part, mine / "state.bin");
+  dem::step(model, part);
+  const std::map<std::int64_t, Vec3> after_checkpoint = forces_by_id(part);
+  for (int n = 1; n < 200; ++n) dem::step(model, part);
+  const auto [kinetic, height] = statistics(part);
+  if (world_rank() == 0) {
+    std::ofstream forces(mine / "forces.txt");
+    forces.precision(17);
+    for (const auto& [id, f] : after_checkpoint) forces << id << ' ' << f.x() << ' ' << f.y() << ' ' << f.z() << '\n';
+    std::ofstream(mine / "statistics.txt") << std::hexfloat << kinetic << ' ' << height << '\n';
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+
+  for (const int writer : {world_size(), world_size() - 1}) {
+    if (writer < 1) continue;
+    const std::filesystem::path from = checkpoint_of(writer);
+    ASSERT_TRUE(std::filesystem::exists(from / "statistics.txt"))
+        << from << " is missing: CTest runs Mpi.Ranks" << writer << " first, which writes it";
+    std::map<std::int64_t, Vec3> expected;
+    std::ifstream forces(from / "forces.txt");
+    for (std::int64_t id; forces >> id;) forces >> expected[id].x() >> expected[id].y() >> expected[id].z();
+    std::ifstream stats(from / "statistics.txt");
+    std::string kinetic_text, height_text;  // hexadecimal: exact
+    stats >> kinetic_text >> height_text;
+    const double expected_kinetic = std::strtod(kinetic_text.c_str(), nullptr);
+    const double expected_height = std::strtod(height_text.c_str(), nullptr);
+
+    const std::string when = "resuming the checkpoint of " + std::to_string(writer) + " ranks";
+    dem::State resumed = dem::read_checkpoint(model, from / "state.bin", dem::make_mpi_exchange());
+    EXPECT_EQ(resumed.step, 200);
+    dem::step(model, resumed);
+    expect_same_forces(expected, forces_by_id(resumed), when.c_str());
+    for (int n = 1; n < 200; ++n) dem::step(model, resumed);
+    expect_every_grain_once(resumed, whole.size());
+    const auto [k, z] = statistics(resumed);
+    EXPECT_NEAR(k, expected_kinetic, 1e-9 * expected_kinetic) << when;
+    EXPECT_NEAR(z, expected_height, 1e-9 * 6e-3) << when;
+  }
 }
 
 int main(int argc, char** argv) {
