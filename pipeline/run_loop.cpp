@@ -14,9 +14,14 @@ namespace app {
 namespace {
 std::atomic<bool> g_interrupted{false};
 
+// Ctrl-C (SIGINT); SIGTERM, which a batch scheduler sends before it kills a job, and which
+// mpirun sends every rank on Ctrl-C; SIGUSR1, which mpirun forwards to every rank as it is. A
+// second signal ends the process as usual.
+constexpr int stop_signals[] = {SIGINT, SIGTERM, SIGUSR1};
+
 void on_interrupt(int) {
   g_interrupted = true;
-  std::signal(SIGINT, SIG_DFL);
+  for (int signal : stop_signals) std::signal(signal, SIG_DFL);
 }
 
 // Split over ranks, Ctrl-C reaches the ranks at different steps: they agree every 64 steps, so
@@ -27,7 +32,9 @@ bool interrupted(const dem::State& s, std::int64_t steps) {
 }
 }  // namespace
 
-void install_interrupt_handler() { std::signal(SIGINT, on_interrupt); }
+void install_interrupt_handler() {
+  for (int signal : stop_signals) std::signal(signal, on_interrupt);
+}
 
 LoopResult run_until(const dem::Model& model, dem::State& s, const LoopOptions& o) {
   LoopResult result;

@@ -38,7 +38,7 @@ struct LoopResult {
   double max_energy_gain = 0;  // 0 when the energy never exceeded its budget
 };
 
-// Installs the Ctrl-C handler (once); a second Ctrl-C kills the process as usual.
+// Installs the handler of Ctrl-C, SIGTERM and SIGUSR1 (once); a second signal kills the process as usual.
 void install_interrupt_handler();
 
 LoopResult run_until(const dem::Model& model, dem::State& state, const LoopOptions& options);
