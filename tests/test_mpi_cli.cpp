@@ -1,0 +1,132 @@
+// diefill itself under mpirun (docs/ARCHITECTURE.md, "Domain decomposition"): the pipeline on the
+// ring over 2 and 3 ranks fills as one process does and repeats its bits on the same rank count,
+// a checkpoint that 2 ranks wrote resumes on 3, and an overlap past the limit stops every rank
+// with exit status 3 and a checkpoint.
+#include <fmt/core.h>
+
+#include <chrono>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "support.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// Two cores run up to three ranks of one thread each.
+test::Run mpirun(int ranks, const std::string& arguments) {
+  return test::run_command(fmt::format("{} -np {} --oversubscribe --allow-run-as-root -x OMP_NUM_THREADS=1 {} {} 2>&1",
+                                       DIEFILL_MPIRUN, ranks, DIEFILL_EXECUTABLE, arguments));
+}
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+const fs::path& suite_out() {
+  static const fs::path out = [] {
+    const fs::path p = fs::temp_directory_path() / ("diefill-mpi-" + std::to_string(::getpid()));
+    fs::remove_all(p);
+    return p;
+  }();
+  return out;
+}
+
+const std::string ring = fmt::format("{}/dies/ring.stl --set powder.coarse_graining=16", DIEFILL_SOURCE_DIR);
+
+// The ring at 1.6 mm grains (α = 16), 0.1 m/s, run by one process on seeds 1 to 15 (measured
+// 2026-12-02: `diefill run dies/ring.stl --set powder.coarse_graining=16 --seed N`): 2,005 grains
+// inserted on seed 1; fill ratio mean 0.5196, standard deviation 0.0022 over the seeds (0.5164 to
+// 0.5237). A run split over ranks is another realisation of the same fill (rounding differences
+// grow in the chaotic flow as a new seed's do), so its fill ratio lies within four deviations of
+// the mean: nine split runs measured 0.5151 to 0.5276, mean 0.5200.
+constexpr double single_process_fill_mean = 0.5196, single_process_fill_sd = 0.0022;
+constexpr int grains_inserted_on_seed_1 = 2005;
+
+// Runs (once per folder) the ring split over `ranks` ranks into suite_out()/folder.
+const nlohmann::json& ring_report(int ranks, const std::string& folder) {
+  static std::map<std::string, nlohmann::json> done;
+  if (auto it = done.find(folder); it != done.end()) return it->second;
+  const test::Run run = mpirun(ranks, "run " + ring + " --out " + (suite_out() / folder).string());
+  EXPECT_EQ(run.status, 0) << run.output;
+  EXPECT_EQ(count(run.output, "ring: report "), 1u) << "rank 0 alone reports:\n" << run.output;
+  return done[folder] = nlohmann::json::parse(test::read_text(suite_out() / folder / "ring" / "report.json"));
+}
+
+void expect_fills_as_one_process(const nlohmann::json& report, const std::string& what) {
+  EXPECT_EQ(report["particles"]["inserted"], grains_inserted_on_seed_1) << what;
+  EXPECT_EQ(report["particles"]["lost"], 0) << what;
+  EXPECT_NEAR(report["fill"]["fill_ratio"].get<double>(), single_process_fill_mean, 4 * single_process_fill_sd) << what;
+}
+
+}  // namespace
+
+TEST(MpiRun, TheRingOverTwoAndThreeRanksFillsAsOneProcessAndRepeatsItsBits) {
+  nlohmann::json first = ring_report(2, "two");
+  nlohmann::json again = ring_report(2, "two_again");
+  const nlohmann::json& three = ring_report(3, "three");
+  EXPECT_EQ(first["timing"]["ranks"], 2);
+  EXPECT_EQ(first["timing"]["threads_per_rank"], 1);
+  EXPECT_EQ(three["timing"]["ranks"], 3);
+  expect_fills_as_one_process(first, "on 2 ranks");
+  expect_fills_as_one_process(three, "on 3 ranks");
+  // Each settled its own shoe, split over two ranks, and filled the die from it: the same bits.
+  first.erase("timing"), again.erase("timing");
+  EXPECT_EQ(first.dump(), again.dump());
+  EXPECT_EQ(test::read_text(suite_out() / "two" / "ring" / "particles.csv"),
+            test::read_text(suite_out() / "two_again" / "ring" / "particles.csv"));
+}
+
+// Stopped by Ctrl-C at mpirun (which sends its ranks SIGTERM) while two ranks fill the die, the
+// run leaves a checkpoint; three ranks resume it and end as the uninterrupted two-rank run from
+// the same settled shoe does, within the spread of realisations.
+TEST(MpiRun, ACheckpointOfTwoRanksResumesOnThree) {
+  const nlohmann::json& uninterrupted = ring_report(2, "two");
+  const fs::path dir = suite_out() / "interrupted";
+  fs::create_directories(dir);
+  fs::copy(suite_out() / "two" / ".cache", dir / ".cache", fs::copy_options::recursive);  // the same settled shoe
+  const std::string args = "run " + ring + " --out " + dir.string();
+  // The shoe is cached, and the fill lasts about ten seconds: stopped two seconds into it. (mpirun
+  // gives its ranks a second after SIGTERM before it kills them; they stop within 64 steps.)
+  const fs::path log_file = dir / "stopped.log";
+  test::run_command(fmt::format("bash -c '{} -np 2 --oversubscribe --allow-run-as-root -x OMP_NUM_THREADS=1 {} {} > {} 2>&1 & "
+                                "pid=$!; for i in $(seq 300); do grep -q filling: {} && break; sleep 0.1; done; sleep 2; "
+                                "kill -INT $pid; wait $pid'",
+                                DIEFILL_MPIRUN, DIEFILL_EXECUTABLE, args, log_file.string(), log_file.string()));
+  const std::string log = test::read_text(log_file);
+  ASSERT_TRUE(fs::exists(dir / "ring" / "checkpoint.bin")) << log;
+  EXPECT_NE(log.find("interrupted; resume with"), std::string::npos) << log;
+  const test::Run resumed = mpirun(3, args + " --resume");
+  ASSERT_EQ(resumed.status, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("resumed at"), std::string::npos) << resumed.output;
+  const nlohmann::json report = nlohmann::json::parse(test::read_text(dir / "ring" / "report.json"));
+  EXPECT_EQ(report["timing"]["ranks"], 3);
+  expect_fills_as_one_process(report, "resumed on 3 ranks");
+  EXPECT_NEAR(report["fill"]["fill_ratio"].get<double>(), uninterrupted["fill"]["fill_ratio"].get<double>(),
+              4 * single_process_fill_sd);
+  EXPECT_FALSE(fs::exists(dir / "ring" / "checkpoint.bin")) << "a finished run removes its checkpoint";
+}
+
+// Two grains of 200 overlap by 1.4 radii at the start, on one rank: every rank stops at the first
+// step's check, with exit status 3, one message and a checkpoint, in seconds.
+TEST(MpiSimulate, AnOverlapPastTheLimitOnOneRankStopsEveryRank) {
+  test::TempDir dir;
+  std::string csv = "id,x,y,z,vx,vy,vz,wx,wy,wz,radius\n";
+  for (int n = 0; n < 199; ++n)
+    csv += fmt::format("{},{},{},{},0,0,0,0,0,0,5e-4\n", n, (n % 10) * 1.1e-3, (n / 10 % 5) * 1.1e-3, (n / 50) * 1.1e-3 + 1e-3);
+  csv += "199,3e-4,0,1e-3,0,0,0,0,0,0,5e-4\n";  // 0.3 mm from grain 0: overlapping by 0.7 mm
+  test::write_text(dir / "particles.csv", csv);
+  test::write_text(dir / "scene.toml", "[simulation]\nduration = 0.01\n\n[[materials]]\nname = \"glass\"\nyoungs_modulus = 5e6\n"
+                                       "\n[particles]\nfile = \"particles.csv\"\n"
+                                       "\n[[walls]]\ntype = \"plane\"\nnormal = [0.0, 0.0, 1.0]\n");
+  const auto start = std::chrono::steady_clock::now();
+  const test::Run run = mpirun(2, "simulate " + (dir / "scene.toml").string() + " --out " + (dir / "out").string());
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(run.status, 3) << run.output;
+  EXPECT_EQ(count(run.output, "stopped: a contact overlap reached"), 1u) << run.output;
+  EXPECT_TRUE(fs::exists(dir / "out" / "checkpoint.bin"));
+  EXPECT_LT(seconds, 10.0);
+}
