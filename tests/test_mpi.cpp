@@ -254,6 +254,54 @@ TEST_P(MpiRingDie, ForcesMatchTheWholeScene) {
 // At rest, and moving through the grains at 0.5 m/s, as the shoe does.
 INSTANTIATE_TEST_SUITE_P(WallSpeeds, MpiRingDie, ::testing::Values(0.0, 0.5));
 
+// A grain rolls on the floor of the box across the face between two subdomains (two blocks of
+// grains resting apart on the floor put a cut between it and the farther block); its tangential
+// spring with the floor must migrate with it (carried without it, the force after the migration
+// differs by its whole size). At every step its force is the whole scene's to
+// 1e-12 of its size, and it did change rank while moving.
+TEST(MpiSplit, AGrainRollingAcrossASubdomainFaceKeepsItsSpring) {
+  const dem::ModelSpec spec = box_spec(true);
+  const double r = 0.25e-3, floor = -6e-3;
+  dem::State whole;
+  for (const double x0 : {-5.5e-3, 3e-3})
+    for (int a = 0; a < 6; ++a)
+      for (int b = 0; b < 8; ++b)
+        whole.add_sphere(std::int64_t(whole.size()), Vec3(x0 + 2.05 * r * a, -4e-3 + 2.05 * r * b, floor + r), r, 2500, 0);
+  const std::int64_t slider = std::int64_t(whole.size());
+  // Rolling without slip: the floor's spring sticks (a sliding one sits at the Coulomb limit,
+  // which a spring started afresh reaches again in one step).
+  whole.add_sphere(slider, Vec3(-1.5e-3, 0, floor + r), r, 2500, 0, Vec3(-0.3, 0, 0), Vec3(0, -0.3 / r, 0));
+  const dem::Model model = dem::compile_model(spec, whole, "mpi slider");
+  dem::State part = split(whole);
+  dem::initialize(model, whole);
+  dem::initialize(model, part);
+  const auto owner_of_slider = [&] {
+    double mine = -1;
+    for (std::size_t i = 0; i < part.owned(); ++i)
+      if (part.id[i] == slider) mine = world_rank();
+    return int(part.exchange->max(mine));
+  };
+  const int first_owner = owner_of_slider();
+  int steps_after_moving = -1;
+  double worst = 0, speed_at_crossing = 0;
+  // Until 100 steps after it changed rank (on one rank: until it is past where the cut would be).
+  for (int n = 0; n < 20000 && steps_after_moving < 100; ++n) {
+    dem::step(model, whole);
+    dem::step(model, part);
+    const std::size_t k = index_by_id(whole).at(slider);
+    const std::map<std::int64_t, Vec3> forces = forces_by_id(part);
+    worst = std::max(worst, (forces.at(slider) - whole.f[k]).norm() / whole.f[k].norm());
+    if (steps_after_moving >= 0) ++steps_after_moving;
+    else if (owner_of_slider() != first_owner) steps_after_moving = 0, speed_at_crossing = whole.v[k].norm();
+    if (world_size() == 1 && whole.x[k].x() < -3.6e-3) break;
+  }
+  if (world_size() > 1) {
+    EXPECT_GE(steps_after_moving, 0) << "the grain never changed rank";
+    EXPECT_GT(speed_at_crossing, 0.1) << "it crossed moving";
+  }
+  EXPECT_LT(worst, 1e-12);
+}
+
 TEST(MpiSplit, MomentumIsConservedInFreeFlight) {
   const dem::ModelSpec spec = box_spec(false);
   dem::State whole = pack(4000, 0.5);
