@@ -6,6 +6,7 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -300,6 +301,30 @@ TEST(MpiSplit, AGrainRollingAcrossASubdomainFaceKeepsItsSpring) {
     EXPECT_GT(speed_at_crossing, 0.1) << "it crossed moving";
   }
   EXPECT_LT(worst, 1e-12);
+}
+
+// Memory is distributed, not replicated: 50,000 grains packed as densely as the settled packs of
+// ../shared/bench/liggghts (a lattice 2 % tighter than the grains, in a cylinder as tall as it is
+// wide) over four ranks: no rank holds more than 40 % of them, ghosts included, by its own count
+// (the 50k LIGGGHTS pack itself measured 28.8 %: README, "Over MPI ranks").
+TEST(MpiSplit, FourRanksEachHoldAtMostFortyPercentOfFiftyThousandGrains) {
+  const dem::ModelSpec spec = box_spec(false);
+  const double r = 0.1e-3, spacing = 1.96 * r;
+  dem::State whole;
+  for (int a = -20; a < 20; ++a)
+    for (int b = -20; b < 20; ++b)
+      for (int c = -20; c < 20; ++c)
+        if (std::hypot(a + 0.5, b + 0.5) < 20.0)
+          whole.add_sphere(std::int64_t(whole.size()), spacing * Vec3(a + 0.5, b + 0.5, c + 0.5), r, 2500, 0);
+  ASSERT_GT(whole.size(), 49000u);
+  const dem::Model model = dem::compile_model(spec, whole, "mpi memory");
+  dem::State part = split(whole);
+  dem::initialize(model, part);
+  const double share = double(part.size()) / double(whole.size());
+  if (world_size() == 4) EXPECT_LE(share, 0.40) << "rank " << world_rank() << " holds " << part.owned() << " grains and "
+                                                 << part.ghosts << " ghosts";
+  EXPECT_EQ(part.exchange->sum(std::int64_t(part.owned())), std::int64_t(whole.size()));
+  if (world_rank() == 0) std::printf("%d ranks: rank 0 holds %.1f %% of the grains with its ghosts\n", world_size(), 100 * share);
 }
 
 TEST(MpiSplit, MomentumIsConservedInFreeFlight) {
