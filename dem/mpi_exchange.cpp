@@ -26,11 +26,10 @@ struct Migrant {
 struct GhostMotion {
   Vec3 x, v, w;
 };
-// A grain as the partitioner weighs it.
+// A grain as the partitioner weighs it: itself and its listed pairs.
 struct WeightedPoint {
   Vec3 x;
-  double weight;
-  std::int64_t id;
+  std::int64_t weight;
 };
 
 // The subdomains: a tree of cuts, each leaf a rank; its boxes tile all of space.
@@ -90,7 +89,6 @@ class MpiExchange final : public Exchange {
   // Each rank's buffer to it; returns what every rank sent here, in rank order.
   std::vector<char> all_to_all(const std::vector<std::vector<char>>& out) const;
   void partition(const std::vector<WeightedPoint>& local);
-  int bisect(std::vector<WeightedPoint>& points, std::size_t first, std::size_t last, int lo, int hi, const Box& box);
   int owner(const Vec3& x) const {
     int node = 0;
     while (cuts_[std::size_t(node)].axis >= 0) {
@@ -134,56 +132,91 @@ std::vector<char> MpiExchange::gather(const std::vector<char>& local) {
   return all;
 }
 
-// Recursive coordinate bisection of every rank's grains, computed alike on every rank from the
-// gathered points: each cut across the longest extent of its grains, where the weight below it
-// is the share of the ranks below it.
+// Recursive coordinate bisection computed by all ranks together, level by level (as Zoltan's RCB
+// does), each rank looking at its own grains only: a cut goes across the longest extent of its
+// grains and is placed by bisecting the coordinate until the weight below it reaches the share of
+// the ranks below it. Extents are reduced by minimum and weights as integers, so that every rank
+// and every run finds the same cuts.
 void MpiExchange::partition(const std::vector<WeightedPoint>& local) {
-  const int bytes = int(local.size() * sizeof(WeightedPoint));
-  std::vector<int> counts(static_cast<std::size_t>(ranks_)), at(static_cast<std::size_t>(ranks_), 0);
-  MPI_Allgather(&bytes, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
-  for (std::size_t r = 1; r < std::size_t(ranks_); ++r) at[r] = at[r - 1] + counts[r - 1];
-  std::vector<WeightedPoint> all(std::size_t(at.back() + counts.back()) / sizeof(WeightedPoint));
-  MPI_Allgatherv(local.data(), bytes, MPI_BYTE, all.data(), counts.data(), at.data(), MPI_BYTE, MPI_COMM_WORLD);
-  cuts_.clear();
+  struct Node {
+    int lo, hi, tree;  // ranks [lo, hi); its index in cuts_
+    Box box;
+  };
+  cuts_.assign(1, Cut{});
   boxes_.assign(std::size_t(ranks_), Box{});
-  bisect(all, 0, all.size(), 0, ranks_, Box{});
-}
-
-int MpiExchange::bisect(std::vector<WeightedPoint>& points, std::size_t first, std::size_t last, int lo, int hi, const Box& box) {
-  const int node = int(cuts_.size());
-  cuts_.emplace_back();
-  if (hi - lo == 1) {
-    cuts_[std::size_t(node)].rank = lo;
-    boxes_[std::size_t(lo)] = box;
-    return node;
+  std::vector<Node> level;
+  if (ranks_ > 1) level.push_back({0, ranks_, 0, Box{}});
+  else cuts_[0].rank = 0;
+  std::vector<int> node_of(local.size(), ranks_ > 1 ? 0 : -1);  // the grain's node in `level`; -1: in a leaf
+  constexpr int bisection_steps = 52;         // to the last bit of a double's mantissa
+  while (!level.empty()) {
+    const std::size_t m = level.size();
+    // Per node: lows and negated highs of the grains (one minimum), and their total weight.
+    std::vector<double> extent(6 * m, std::numeric_limits<double>::infinity());
+    std::vector<std::int64_t> total(m, 0);
+    for (std::size_t k = 0; k < local.size(); ++k) {
+      if (node_of[k] < 0) continue;
+      const std::size_t n = std::size_t(node_of[k]);
+      for (int a = 0; a < 3; ++a)
+        extent[6 * n + std::size_t(a)] = std::min(extent[6 * n + std::size_t(a)], local[k].x[a]),
+        extent[6 * n + 3 + std::size_t(a)] = std::min(extent[6 * n + 3 + std::size_t(a)], -local[k].x[a]);
+      total[n] += local[k].weight;
+    }
+    MPI_Allreduce(MPI_IN_PLACE, extent.data(), int(6 * m), MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+    MPI_Allreduce(MPI_IN_PLACE, total.data(), int(m), MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD);
+    std::vector<int> axis(m, 0);
+    std::vector<double> low(m), high(m);  // the bisection's interval
+    for (std::size_t n = 0; n < m; ++n) {
+      const Vec3 lo(extent[6 * n], extent[6 * n + 1], extent[6 * n + 2]), hi(-extent[6 * n + 3], -extent[6 * n + 4], -extent[6 * n + 5]);
+      if (total[n] > 0) (hi - lo).maxCoeff(&axis[n]);
+      // No grains: any cut will do.
+      low[n] = total[n] > 0 ? lo[axis[n]] : std::clamp(0.0, level[n].box.lo[0], level[n].box.hi[0]);
+      high[n] = total[n] > 0 ? hi[axis[n]] : low[n];
+    }
+    std::vector<std::int64_t> below(m);
+    for (int step = 0; step < bisection_steps; ++step) {
+      std::fill(below.begin(), below.end(), 0);
+      for (std::size_t k = 0; k < local.size(); ++k)
+        if (const int n = node_of[k]; n >= 0 && local[k].x[axis[std::size_t(n)]] < 0.5 * (low[std::size_t(n)] + high[std::size_t(n)]))
+          below[std::size_t(n)] += local[k].weight;
+      MPI_Allreduce(MPI_IN_PLACE, below.data(), int(m), MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD);
+      for (std::size_t n = 0; n < m; ++n) {
+        const Node& node = level[n];
+        const int mid = node.lo + (node.hi - node.lo) / 2;
+        const double at = 0.5 * (low[n] + high[n]);
+        (below[n] * (node.hi - node.lo) < total[n] * (mid - node.lo) ? low[n] : high[n]) = at;
+      }
+    }
+    std::vector<Node> next;
+    std::vector<int> child(2 * m, -1);  // per node: its lower and upper child's index in `next`
+    for (std::size_t n = 0; n < m; ++n) {
+      const Node& node = level[n];
+      const int mid = node.lo + (node.hi - node.lo) / 2;
+      Cut& cut = cuts_[std::size_t(node.tree)];
+      cut.axis = axis[n], cut.at = high[n];
+      Box lower = node.box, upper = node.box;
+      lower.hi[cut.axis] = upper.lo[cut.axis] = cut.at;
+      const std::pair<int, int> halves[2] = {{node.lo, mid}, {mid, node.hi}};
+      for (int side = 0; side < 2; ++side) {
+        const int tree = int(cuts_.size());
+        cuts_.emplace_back();
+        (side == 0 ? cuts_[std::size_t(node.tree)].below : cuts_[std::size_t(node.tree)].above) = tree;
+        const auto [lo, hi] = halves[side];
+        const Box& box = side == 0 ? lower : upper;
+        if (hi - lo == 1) {
+          cuts_[std::size_t(tree)].rank = lo;
+          boxes_[std::size_t(lo)] = box;
+        } else {
+          child[2 * n + std::size_t(side)] = int(next.size());
+          next.push_back({lo, hi, tree, box});
+        }
+      }
+    }
+    for (std::size_t k = 0; k < local.size(); ++k)
+      if (const int n = node_of[k]; n >= 0)
+        node_of[k] = child[2 * std::size_t(n) + (local[k].x[axis[std::size_t(n)]] < high[std::size_t(n)] ? 0 : 1)];
+    level.swap(next);
   }
-  const int mid = lo + (hi - lo) / 2;
-  Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity()), high = -low;
-  for (std::size_t k = first; k < last; ++k) low = low.cwiseMin(points[k].x), high = high.cwiseMax(points[k].x);
-  int axis = 0;
-  double cut = std::clamp(0.0, box.lo[0], box.hi[0]);  // no grains: any cut will do
-  std::size_t split = first;
-  if (last > first) {
-    (high - low).maxCoeff(&axis);
-    std::sort(points.begin() + std::ptrdiff_t(first), points.begin() + std::ptrdiff_t(last),
-              [axis](const WeightedPoint& a, const WeightedPoint& b) {
-                return a.x[axis] != b.x[axis] ? a.x[axis] < b.x[axis] : a.id < b.id;
-              });
-    double total = 0;
-    for (std::size_t k = first; k < last; ++k) total += points[k].weight;
-    const double below = total * double(mid - lo) / double(hi - lo);
-    double sum = 0;
-    while (split < last && sum + 0.5 * points[split].weight < below) sum += points[split++].weight;
-    cut = split == first ? points[first].x[axis] : split == last ? std::nextafter(points[last - 1].x[axis], box.hi[axis])
-                                                                 : 0.5 * (points[split - 1].x[axis] + points[split].x[axis]);
-  }
-  Box lower = box, upper = box;
-  lower.hi[axis] = upper.lo[axis] = cut;
-  const int below_node = bisect(points, first, split, lo, mid, lower);
-  const int above_node = bisect(points, split, last, mid, hi, upper);
-  Cut& c = cuts_[std::size_t(node)];
-  c.axis = axis, c.at = cut, c.below = below_node, c.above = above_node;
-  return node;
 }
 
 void MpiExchange::redistribute(const Model& model, State& s) {
@@ -204,13 +237,13 @@ void MpiExchange::migrate(State& s) {
   std::vector<WeightedPoint> points;
   // The cost of a grain: its listed pairs, and itself.
   for (std::size_t i = 0; i < owned; ++i)
-    if (s.active[i]) points.push_back({s.x[i], 1.0 + (listed ? double(nl.row_start[i + 1] - nl.row_start[i]) : 0.0), s.id[i]});
+    if (s.active[i]) points.push_back({s.x[i], 1 + (listed ? std::int64_t(nl.row_start[i + 1] - nl.row_start[i]) : 0)});
   if (s.wall_slots.size() == nl.near_wall.size() * wall_slots_per_particle)
     for (std::size_t q = 0; q < nl.near_wall.size(); ++q) slots_of[std::size_t(nl.near_wall[q])] = &s.wall_slots[q * wall_slots_per_particle];
 
   // Cut anew at the first call, or when the heaviest rank carries more than 1.2 times the mean.
   double work = 0;
-  for (const WeightedPoint& p : points) work += p.weight;
+  for (const WeightedPoint& p : points) work += double(p.weight);
   const double heaviest = max(work), mean = sum(work) / ranks_;
   if (cuts_.empty() || heaviest > 1.2 * mean) partition(points);
 
