@@ -44,6 +44,7 @@ struct Box {
   double distance(const Vec3& p) const {
     return (lo - p).cwiseMax(p - hi).cwiseMax(0.0).norm();
   }
+  double distance(const Box& other) const { return (lo - other.hi).cwiseMax(other.lo - hi).cwiseMax(0.0).norm(); }
 };
 
 class MpiExchange final : public Exchange {
@@ -88,6 +89,9 @@ class MpiExchange final : public Exchange {
  private:
   // Each rank's buffer to it; returns what every rank sent here, in rank order.
   std::vector<char> all_to_all(const std::vector<std::vector<char>>& out) const;
+  // The same when only the neighbouring subdomains' buffers can hold anything: messages to and
+  // from them alone, so that a step's cost does not grow with the number of ranks.
+  std::vector<char> with_neighbours(const std::vector<std::vector<char>>& out) const;
   void partition(const std::vector<WeightedPoint>& local);
   int owner(const Vec3& x) const {
     int node = 0;
@@ -104,6 +108,9 @@ class MpiExchange final : public Exchange {
   std::vector<Cut> cuts_;
   std::vector<Box> boxes_;                   // [ranks]
   std::vector<std::vector<std::int32_t>> send_;  // [ranks] owned grains ghosted there, in send order
+  // The other ranks whose boxes lie within ghost reach of this one's, ascending: the only ones a
+  // ghost goes to or a grain migrates to between two cuts.
+  std::vector<int> neighbours_;
 };
 
 std::vector<char> MpiExchange::all_to_all(const std::vector<std::vector<char>>& out) const {
@@ -130,6 +137,28 @@ std::vector<char> MpiExchange::gather(const std::vector<char>& local) {
   std::vector<char> all(rank_ == 0 ? std::size_t(at.back() + counts.back()) : 0);
   MPI_Gatherv(local.data(), bytes, MPI_BYTE, all.data(), counts.data(), at.data(), MPI_BYTE, 0, MPI_COMM_WORLD);
   return all;
+}
+
+std::vector<char> MpiExchange::with_neighbours(const std::vector<std::vector<char>>& out) const {
+  const std::size_t n = neighbours_.size();
+  std::vector<int> send_counts(n), receive_counts(n), receive_at(n + 1, 0);
+  std::vector<MPI_Request> requests(2 * n);
+  const auto wait = [&] { MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE); };
+  for (std::size_t k = 0; k < n; ++k) {
+    send_counts[k] = int(out[std::size_t(neighbours_[k])].size());
+    MPI_Irecv(&receive_counts[k], 1, MPI_INT, neighbours_[k], 0, MPI_COMM_WORLD, &requests[k]);
+    MPI_Isend(&send_counts[k], 1, MPI_INT, neighbours_[k], 0, MPI_COMM_WORLD, &requests[n + k]);
+  }
+  wait();
+  for (std::size_t k = 0; k < n; ++k) receive_at[k + 1] = receive_at[k] + receive_counts[k];
+  std::vector<char> received(static_cast<std::size_t>(receive_at[n]));
+  for (std::size_t k = 0; k < n; ++k) {
+    MPI_Irecv(received.data() + receive_at[k], receive_counts[k], MPI_BYTE, neighbours_[k], 1, MPI_COMM_WORLD, &requests[k]);
+    MPI_Isend(out[std::size_t(neighbours_[k])].data(), send_counts[k], MPI_BYTE, neighbours_[k], 1, MPI_COMM_WORLD,
+              &requests[n + k]);
+  }
+  wait();
+  return received;
 }
 
 // Recursive coordinate bisection computed by all ranks together, level by level (as Zoltan's RCB
@@ -245,13 +274,17 @@ void MpiExchange::migrate(State& s) {
   double work = 0;
   for (const WeightedPoint& p : points) work += double(p.weight);
   const double heaviest = max(work), mean = sum(work) / ranks_;
-  if (cuts_.empty() || heaviest > 1.2 * mean) partition(points);
+  const bool recut = cuts_.empty() || heaviest > 1.2 * mean;
+  if (recut) partition(points);
 
   std::vector<std::vector<char>> out(static_cast<std::size_t>(ranks_));
   std::vector<std::size_t> keep;
   Array<std::int32_t> near;
   Array<WallSlot> slots;
   std::vector<CarriedPair> carried;
+  // Between two cuts a grain moves less than the ghost reach between rebuilds, so it migrates to a
+  // neighbour; after a cut, or should one not, every rank may send to every other.
+  bool beyond_neighbours = recut;
   const auto carry = [&](std::size_t i) {
     if (slots_of[i]) {
       near.push_back(std::int32_t(keep.size() - 1));
@@ -267,13 +300,14 @@ void MpiExchange::migrate(State& s) {
       carry(i);
       continue;
     }
+    if (!std::binary_search(neighbours_.begin(), neighbours_.end(), to)) beyond_neighbours = true;
     std::vector<char>& b = out[std::size_t(to)];
     put(b, Migrant{grain_record(s, i), std::int32_t(pairs_of[i].size()), std::uint8_t(slots_of[i] ? 1 : 0)});
     if (slots_of[i])
       for (int k = 0; k < wall_slots_per_particle; ++k) put(b, slots_of[i][k]);
     for (const CarriedPair& c : pairs_of[i]) put(b, c);
   }
-  const std::vector<char> received = all_to_all(out);
+  const std::vector<char> received = max(beyond_neighbours ? 1.0 : 0.0) > 0 ? all_to_all(out) : with_neighbours(out);
   keep_grains(s, keep);
   for (const char* at = received.data(); at < received.data() + received.size();) {
     const Migrant m = take<Migrant>(at);
@@ -296,17 +330,21 @@ void MpiExchange::send_ghosts(const Model& model, State& s) {
   double r_max = 0;
   for (std::size_t i = 0; i < s.size(); ++i) r_max = std::max(r_max, s.radius[i]);
   const double reach = 2 * max(r_max) + model.skin;
+  // The owned grains lie in this rank's box: only boxes within reach of it can want them.
+  neighbours_.clear();
+  for (int r = 0; r < ranks_; ++r)
+    if (r != rank_ && boxes_[std::size_t(r)].distance(boxes_[std::size_t(rank_)]) < reach) neighbours_.push_back(r);
   send_.assign(std::size_t(ranks_), {});
   std::vector<std::vector<char>> out(static_cast<std::size_t>(ranks_));
   for (std::size_t i = 0; i < s.size(); ++i) {
     if (!s.active[i]) continue;
-    for (int r = 0; r < ranks_; ++r)
-      if (r != rank_ && boxes_[std::size_t(r)].distance(s.x[i]) < reach) {
+    for (int r : neighbours_)
+      if (boxes_[std::size_t(r)].distance(s.x[i]) < reach) {
         send_[std::size_t(r)].push_back(std::int32_t(i));
         put(out[std::size_t(r)], grain_record(s, i));
       }
   }
-  const std::vector<char> received = all_to_all(out);
+  const std::vector<char> received = with_neighbours(out);
   for (const char* at = received.data(); at < received.data() + received.size(); ++s.ghosts) {
     append_grain(s, take<GrainRecord>(at));
   }
@@ -316,7 +354,7 @@ void MpiExchange::update_ghosts(State& s) {
   std::vector<std::vector<char>> out(static_cast<std::size_t>(ranks_));
   for (std::size_t r = 0; r < send_.size(); ++r)
     for (std::int32_t i : send_[r]) put(out[r], GhostMotion{s.x[std::size_t(i)], s.v[std::size_t(i)], s.w[std::size_t(i)]});
-  const std::vector<char> received = all_to_all(out);
+  const std::vector<char> received = with_neighbours(out);
   std::size_t g = s.owned();
   for (const char* at = received.data(); at < received.data() + received.size(); ++g) {
     const GhostMotion m = take<GhostMotion>(at);
