@@ -272,9 +272,11 @@ int run_bench(const BenchCommand& c) {
     } else if (name == "run-ring") {
       app::PipelineScene scene = load_pipeline_scene(std::nullopt, {});
       scene.out = c.cache / "run-ring";
-      fs::remove_all(scene.out);
+      const std::shared_ptr<dem::Exchange> ranks = mpi_exchange();  // split under mpirun
+      if (!ranks || ranks->rank() == 0) fs::remove_all(scene.out);
+      if (ranks) ranks->barrier();
       diefill::Stopwatch clock;
-      const DieRun run = run_die_fill(scene, diefill::resource_path("dies/ring.stl"), false);
+      const DieRun run = run_die_fill(scene, diefill::resource_path("dies/ring.stl"), false, ranks);
       results["cases"].push_back({{"name", name},
                                   {"threads", omp_get_max_threads()},
                                   {"wall_s", clock.seconds()},

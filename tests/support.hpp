@@ -2,12 +2,15 @@
 // Helpers shared by the tests: temporary folders, running the diefill executable, test meshes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace test {
 
@@ -38,6 +41,19 @@ struct Run {
   int status = -1;     // exit status
   std::string output;  // stdout and stderr together
 };
+
+// A folder under the system temporary directory for a whole suite's runs, emptied when the
+// process first asks for it and kept afterwards (runs share its caches; a failure leaves them to
+// read): diefill-NAME-<pid>.
+inline fs::path suite_folder(const std::string& name) {
+  const fs::path p = fs::temp_directory_path() / ("diefill-" + name + "-" + std::to_string(::getpid()));
+  static std::vector<fs::path> emptied;
+  if (std::find(emptied.begin(), emptied.end(), p) == emptied.end()) {
+    fs::remove_all(p);
+    emptied.push_back(p);
+  }
+  return p;
+}
 
 // Runs a shell command line and collects what it prints.
 inline Run run_command(const std::string& command) {

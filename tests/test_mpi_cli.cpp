@@ -26,14 +26,7 @@ std::size_t count(const std::string& text, const std::string& what) {
   return n;
 }
 
-const fs::path& suite_out() {
-  static const fs::path out = [] {
-    const fs::path p = fs::temp_directory_path() / ("diefill-mpi-" + std::to_string(::getpid()));
-    fs::remove_all(p);
-    return p;
-  }();
-  return out;
-}
+fs::path suite_out() { return test::suite_folder("mpi"); }
 
 const std::string ring = fmt::format("{}/dies/ring.stl --set powder.coarse_graining=16", DIEFILL_SOURCE_DIR);
 

@@ -27,14 +27,7 @@ namespace fs = std::filesystem;
 fs::path bundled_die(const std::string& name) { return fs::path(DIEFILL_SOURCE_DIR) / "dies" / (name + ".stl"); }
 
 // One output folder for the whole suite, so that runs share the cached die and settled shoe.
-const fs::path& suite_out() {
-  static const fs::path out = [] {
-    const fs::path p = fs::temp_directory_path() / ("diefill-pipeline-" + std::to_string(::getpid()));
-    fs::remove_all(p);
-    return p;
-  }();
-  return out;
-}
+fs::path suite_out() { return test::suite_folder("pipeline"); }
 
 struct RunKey {
   std::string die;
