@@ -89,8 +89,8 @@ void add_density(CLI::App& root, app::DensityCommand& c, std::function<int()>& a
 }
 
 void add_die(CLI::App& root, app::DieCommand& c, std::function<int()>& action) {
-  CLI::App* cmd = root.add_subcommand("die", "Write a bundled die mesh (ring, disc) as binary STL in mm");
-  cmd->add_option("NAME", c.name, "ring or disc")->required();
+  CLI::App* cmd = root.add_subcommand("die", "Write a bundled die mesh (ring, disc, gear, slot) as binary STL in mm");
+  cmd->add_option("NAME", c.name, "ring, disc, gear (24 teeth, module 1.2 mm) or slot (1.2 mm wide)")->required();
   cmd->add_option("-o,--output", c.output, "Output STL")->required();
   cmd->callback([&] { action = [&] { return app::run_die(c); }; });
 }

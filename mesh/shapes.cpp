@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "core/error.hpp"
 
@@ -43,6 +44,59 @@ void add_fan(TriMesh& m, int centre, int ring, int n, bool up) {
     if (up) m.triangles.push_back({centre, ring + i, ring + j});
     else m.triangles.push_back({centre, ring + j, ring + i});
   }
+}
+// A cavity whose outline (counter-clockwise, star-shaped about the z axis: its polar angle rises
+// along it) is extruded from z = -depth to the table at z = 0: caps fanned from the axis, each
+// side segment one full-height quad.
+TriMesh extruded_cavity(const std::vector<Eigen::Vector2d>& outline, double depth) {
+  TriMesh m;
+  const int n = int(outline.size());
+  for (const double z : {-depth, 0.0})
+    for (const Eigen::Vector2d& p : outline) m.vertices.emplace_back(p.x(), p.y(), z);
+  const int bottom = 0, top = n;
+  add_strip(m, bottom, top, n, false);
+  const int top_centre = int(m.vertices.size());
+  m.vertices.emplace_back(0.0, 0.0, 0.0);
+  const int bottom_centre = int(m.vertices.size());
+  m.vertices.emplace_back(0.0, 0.0, -depth);
+  add_fan(m, top_centre, top, n, true);
+  add_fan(m, bottom_centre, bottom, n, false);
+  return m;
+}
+
+// An involute spur gear's outline: 20° pressure angle, addendum one module, dedendum 1.25
+// modules (ISO 53). Below the base circle each flank runs straight to the root circle, a little
+// aside so that the polar angle keeps rising.
+std::vector<Eigen::Vector2d> gear_outline(int teeth, double module) {
+  const double pressure = 20.0 * pi / 180, pitch = 0.5 * module * teeth, base = pitch * std::cos(pressure);
+  const double tip = pitch + module, root = pitch - 1.25 * module;
+  const auto involute = [](double a) { return std::tan(a) - a; };
+  // The tooth's half angle at radius r (r from the base circle to the tip).
+  const auto half_angle = [&](double r) {
+    return pi / (2 * teeth) + involute(pressure) - involute(std::acos(std::min(1.0, base / r)));
+  };
+  const double aside = 0.01, at_base = half_angle(base) + aside;
+  const auto polar = [](double r, double a) { return Eigen::Vector2d(r * std::cos(a), r * std::sin(a)); };
+  constexpr int flank_points = 9, tip_points = 2, root_points = 4;
+  std::vector<Eigen::Vector2d> out;
+  for (int k = 0; k < teeth; ++k) {
+    const double centre = 2 * pi * k / teeth;
+    out.push_back(polar(root, centre - at_base));
+    for (int i = 0; i < flank_points; ++i) {
+      const double r = base + (tip - base) * i / (flank_points - 1);
+      out.push_back(polar(r, centre - half_angle(r)));
+    }
+    for (int i = 1; i <= tip_points; ++i)
+      out.push_back(polar(tip, centre - half_angle(tip) + 2 * half_angle(tip) * i / (tip_points + 1)));
+    for (int i = flank_points - 1; i >= 0; --i) {
+      const double r = base + (tip - base) * i / (flank_points - 1);
+      out.push_back(polar(r, centre + half_angle(r)));
+    }
+    out.push_back(polar(root, centre + at_base));
+    const double gap = 2 * pi / teeth - 2 * at_base;
+    for (int i = 1; i <= root_points; ++i) out.push_back(polar(root, centre + at_base + gap * i / (root_points + 1)));
+  }
+  return out;
 }
 }  // namespace
 
@@ -119,13 +173,16 @@ TriMesh shoe_solid(double inner_length, double inner_width, double height, doubl
 }
 
 std::vector<std::string> bundled_die_names() { return {"disc", "ring"}; }
+std::vector<std::string> generated_die_names() { return {"disc", "gear", "ring", "slot"}; }
 
 TriMesh bundled_die(const std::string& name) {
   // Chord error 5 µm: half the 0.01 mm the dies must meet.
   constexpr double chord = 5e-6;
   if (name == "disc") return ring_cavity(20e-3, 0.0, 10e-3, chord);
   if (name == "ring") return ring_cavity(20e-3, 10e-3, 10e-3, chord);
-  throw diefill::InputError("", "die", "unknown bundled die '" + name + "'", "Use disc or ring");
+  if (name == "gear") return extruded_cavity(gear_outline(24, 1.2e-3), 8e-3);
+  if (name == "slot") return extruded_cavity({{-5e-3, -0.6e-3}, {5e-3, -0.6e-3}, {5e-3, 0.6e-3}, {-5e-3, 0.6e-3}}, 8e-3);
+  throw diefill::InputError("", "die", "unknown bundled die '" + name + "'", "Use disc, ring, gear or slot");
 }
 
 }  // namespace mesh

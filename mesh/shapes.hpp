@@ -21,9 +21,14 @@ TriMesh box_solid(const Vec3& lo, const Vec3& hi);
 // the inner rectangle is centred on the origin.
 TriMesh shoe_solid(double inner_length, double inner_width, double height, double thickness);
 
-// The bundled dies by name ("ring", "disc"); throws InputError for other names.
+// The bundled dies by name; throws InputError for other names. "ring" and "disc" are kept in
+// dies/ (bundled_die_names). "gear" and "slot" have sharp features between close cavity features,
+// made as a CAD tool extrudes a profile (fans of sliver triangles from the axis, full-height side
+// quads): a spur gear of 24 involute teeth, module 1.2 mm, 8 mm deep; a slot 1.2 mm wide, 10 mm
+// long, 8 mm deep.
 TriMesh bundled_die(const std::string& name);
 std::vector<std::string> bundled_die_names();
+std::vector<std::string> generated_die_names();  // every name bundled_die takes
 
 // Largest distance between a circle and its inscribed polygon of `segments` sides.
 double chord_error(double radius, int segments);

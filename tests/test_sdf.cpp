@@ -5,6 +5,7 @@
 
 #include "mesh/die.hpp"
 #include "mesh/exact.hpp"
+#include "mesh/import.hpp"
 #include "mesh/shapes.hpp"
 #include "mesh/verify.hpp"
 #include "support.hpp"
@@ -56,6 +57,56 @@ TEST_P(SdfOnBundledDie, GridNodesHoldExactDistances) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Dies, SdfOnBundledDie, ::testing::Values("ring", "disc"));
+
+// Random samples rarely land where a wrong sign would do harm: beside the sharp edges and corners
+// of close cavity features, where the closest feature is an edge or a vertex shared by sliver
+// triangles. So the points here sit within 0.8 mm of every vertex of the gear's and the slot's
+// extruded outlines (at the floor, at mid-depth and at the table), as grains of 0.4 mm radius
+// touching the walls would; for each farther than half a voxel from the surface, the field's
+// sign and every wall contact's sign must be the exact (Embree) one.
+class SignAtSharpFeatures : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(SignAtSharpFeatures, IsTheExactSignBesideEveryEdgeAndCorner) {
+  const std::string name = GetParam();
+  test::TempDir dir;
+  const mesh::TriMesh cavity = mesh::bundled_die(name);
+  mesh::write_stl(cavity, dir / "die.stl", mesh::LengthUnit::mm, "diefill " + name + " cavity, mm");
+  const double r = 0.4e-3;
+  const mesh::PreparedDie die = mesh::prepare_die(dir / "die.stl", mesh::die_options_for_grains(r, 0.5 * r), std::nullopt);
+  const mesh::ExactSurface exact(die.solid);
+  const mesh::WallField field = die.sdf.wall_field(die.solid);
+  std::mt19937_64 random(5);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), reach(0.02e-3, 0.8e-3);
+  std::size_t checked = 0, field_wrong = 0, contact_wrong = 0;
+  Vec3 first_wrong = Vec3::Zero();
+  const int per_vertex = std::max(12, int(24000 / cavity.vertices.size()));  // at least 10^4 points in all
+  for (const Vec3& v : cavity.vertices) {
+    if (v.head<2>().norm() < 1e-9) continue;  // the caps' centres
+    for (const double z : {v.z(), -4e-3}) {
+      for (int n = 0; n < per_vertex; ++n) {
+        Vec3 u(unit(random), unit(random), unit(random));
+        if (u.norm() < 1e-3) continue;
+        const Vec3 p = Vec3(v.x(), v.y(), z) + reach(random) * u.normalized();
+        const double truth = exact.signed_distance(p);
+        if (std::abs(truth) < 0.5 * field.voxel) continue;
+        ++checked;
+        if ((field.signed_distance(p) < 0) != (truth < 0)) {
+          if (field_wrong++ == 0) first_wrong = p;
+        }
+        mesh::SurfacePoint contacts[4];
+        const int count = field.local_minima(p, r, contacts, 4);
+        for (int c = 0; c < count; ++c) contact_wrong += (contacts[c].distance < 0) != (truth < 0);
+      }
+    }
+  }
+  EXPECT_GT(checked, 10000u);
+  EXPECT_EQ(field_wrong, 0u) << name << ": first at (" << first_wrong.transpose() * 1e3 << ") mm";
+  EXPECT_EQ(contact_wrong, 0u) << name;
+  std::printf("%s: %zu points beside edges and corners, %zu signs wrong, %zu contact signs wrong\n", name.c_str(), checked,
+              field_wrong, contact_wrong);
+}
+
+INSTANTIATE_TEST_SUITE_P(Dies, SignAtSharpFeatures, ::testing::Values("gear", "slot"));
 
 TEST(Sdf, BandCoversContactRangeAndSkinOnly) {
   const mesh::DieOptions o = default_options();
