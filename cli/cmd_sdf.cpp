@@ -57,6 +57,12 @@ int run_sdf(const SdfCommand& c) {
     };
     show("wall query (what the simulation uses; errors where grain centres go, signs everywhere)", v.query);
     show("grid, trilinear", v.grid);
+    fmt::print("  beside sharp edges: {} points within two voxels of them with |exact| > 0.5 voxel; sign disagreements {}, "
+               "in wall contacts {}\n",
+               v.sharp_samples, v.sharp_sign_disagreements, v.sharp_contact_sign_disagreements);
+    if (v.sharp_sign_disagreements + v.sharp_contact_sign_disagreements > 0)
+      fmt::print("    first at ({:.4f}, {:.4f}, {:.4f}) mm\n", v.first_sharp_disagreement.x() / mm,
+                 v.first_sharp_disagreement.y() / mm, v.first_sharp_disagreement.z() / mm);
   }
   if (!c.output.empty()) {
     die.sdf.write(c.output);

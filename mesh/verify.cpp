@@ -55,6 +55,39 @@ class SegmentProximity {
   std::unordered_map<std::uint64_t, std::vector<std::size_t>> cells_;
 };
 
+// Points within two voxels of the sharp edges, uniform along them (SdfVerification).
+void verify_beside_sharp_edges(const WallField& field, const ExactSurface& exact, const std::vector<Segment>& edges,
+                               std::size_t samples, std::mt19937_64& rng, SdfVerification& out) {
+  std::vector<double> running;
+  double length = 0;
+  for (const Segment& e : edges) running.push_back(length += (e.b - e.a).norm());
+  if (edges.empty() || length <= 0) return;
+  const double h = field.voxel;
+  std::uniform_real_distribution<double> along(0.0, length), unit(-1.0, 1.0), reach(0.0, 2.0 * h);
+  bool found_one = false;
+  for (std::size_t attempt = 0; out.sharp_samples < samples && attempt < 50 * samples; ++attempt) {
+    const double at = along(rng);
+    const std::size_t k = std::min(edges.size() - 1, std::size_t(std::upper_bound(running.begin(), running.end(), at) - running.begin()));
+    const Segment& e = edges[k];
+    const double start = k == 0 ? 0.0 : running[k - 1];
+    const Vec3 on_edge = e.a + (e.b - e.a) * ((at - start) / std::max(1e-300, running[k] - start));
+    const Vec3 direction(unit(rng), unit(rng), unit(rng));
+    if (direction.norm() < 1e-3) continue;
+    const Vec3 p = on_edge + reach(rng) * direction.normalized();
+    const double reference = exact.signed_distance(p);
+    if (std::abs(reference) <= 0.5 * h) continue;
+    ++out.sharp_samples;
+    const bool inside = reference < 0;
+    bool wrong = (field.signed_distance(p) < 0) != inside;
+    out.sharp_sign_disagreements += wrong;
+    SurfacePoint contacts[4];
+    const int count = field.local_minima(p, 2.0 * h, contacts, 4);
+    for (int c = 0; c < count; ++c)
+      if ((contacts[c].distance < 0) != inside) ++out.sharp_contact_sign_disagreements, wrong = true;
+    if (wrong && !found_one) out.first_sharp_disagreement = p, found_one = true;
+  }
+}
+
 }  // namespace
 
 SdfVerification verify_sdf(const WallField& field, const TriMesh& mesh, const ExactSurface& exact,
@@ -137,6 +170,7 @@ SdfVerification verify_sdf(const WallField& field, const TriMesh& mesh, const Ex
     out.query.mean_voxels = query_sum / double(std::max<std::size_t>(1, out.reachable_samples));
     out.grid.mean_voxels = grid_sum / double(out.samples);
   }
+  verify_beside_sharp_edges(field, exact, sharp_edges(mesh, sharp_angle_deg), samples, rng, out);
   return out;
 }
 

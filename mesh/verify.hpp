@@ -25,6 +25,14 @@ struct SdfVerification {
   SdfErrors query;                 // the simulation's wall query (WallField::signed_distance): its
                                    // errors over the reachable samples, its signs over all
   SdfErrors grid;                  // plain trilinear interpolation of the .vdb grid
+  // Beside the sharp edges, where uniform samples seldom land and a wrong sign does harm: as many
+  // points again within two voxels of a random point of a sharp edge (uniform along the edges),
+  // the query's sign and the signs of its wall contacts within two voxels (local_minima)
+  // against the exact one, where |exact| > 0.5 voxel.
+  std::size_t sharp_samples = 0;
+  std::size_t sharp_sign_disagreements = 0;
+  std::size_t sharp_contact_sign_disagreements = 0;
+  Vec3 first_sharp_disagreement = Vec3::Zero();
 };
 
 // `samples` uniformly random points in the band, reproducible from `seed`; sharp edges are

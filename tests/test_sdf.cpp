@@ -180,3 +180,4 @@ TEST(Sdf, InteriorBandHoldsATrilinearSampleOneAndAHalfVoxelsDeep) {
     EXPECT_NEAR(field.trilinear(p), -d, 0.01 * o.voxel_m) << "depth " << d / o.voxel_m << " voxels";
   }
 }
+

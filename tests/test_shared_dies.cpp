@@ -108,3 +108,26 @@ TEST(WallQuery, MinimaOfBothSignsWidenTheSearchToTheTrueClosestTriangle) {
   ASSERT_GT(n, 0);
   for (int k = 0; k < n; ++k) EXPECT_LT(contacts[k].distance, 0) << "a point inside is inside for every contact";
 }
+
+// Beside a sheet thinner than a voxel: on the flange disc at 0.2 mm voxels two faces lie back to
+// back microns apart, and every candidate triangle within reach leads to the one these points lie
+// behind (they were 0.1669 and 0.1461 mm "inside") while the exact closest face, 0.5 to 2 µm
+// nearer, faces them: they are outside. `diefill sdf --verify` found them beside the sharp edges
+// (3 of 50,000 points there). The grid's sign, outside by more than half a voxel, now wins.
+TEST(WallQuery, APointBesideASheetThinnerThanAVoxelIsOutside) {
+  REQUIRE_SHARED_MESHES();
+  mesh::DieOptions o = mesh::die_options_for_grains(0.5e-3, 0.25e-3, 0.2e-3);
+  const mesh::PreparedDie die =
+      mesh::prepare_die(test::shared_meshes() / "dies" / "blind_flange_disc_trimesh_counter_mm.stl", o, std::nullopt);
+  const mesh::WallField field = die.sdf.wall_field(die.solid);
+  const mesh::ExactSurface exact(die.solid);
+  for (const mesh::Vec3& p : {mesh::Vec3(-44.6740e-3, 46.9778e-3, 279.1630e-3), mesh::Vec3(119.6250e-3, 40.9364e-3, 280.5783e-3)}) {
+    const double truth = exact.signed_distance(p);
+    ASSERT_GT(truth, 0.5 * field.voxel) << p.transpose() * 1e3;
+    EXPECT_NEAR(field.signed_distance(p), truth, 0.01 * field.voxel) << p.transpose() * 1e3;
+    mesh::SurfacePoint contacts[4];
+    const int n = field.local_minima(p, 0.5e-3, contacts, 4);
+    ASSERT_GT(n, 0);
+    for (int k = 0; k < n; ++k) EXPECT_GT(contacts[k].distance, 0) << "every contact of a point outside is outside";
+  }
+}
