@@ -42,7 +42,17 @@ int run_simulate(const SimulateCommand& c) {
                      scene.source, grains, model.dt, model.dt_rayleigh, model.dt_hertz, model.skin);
 
   std::unique_ptr<dem::TrajectoryWriter> trajectory;
-  if (scene.output.trajectory && root) trajectory = std::make_unique<dem::TrajectoryWriter>(dir / "trajectory.csv");
+  if (!ranks) {
+    if (scene.output.trajectory) trajectory = std::make_unique<dem::TrajectoryWriter>(dir / "trajectory.csv");
+  } else {
+    std::exception_ptr failure;  // rank 0 opens it; should that fail, every rank stops
+    try {
+      if (scene.output.trajectory && root) trajectory = std::make_unique<dem::TrajectoryWriter>(dir / "trajectory.csv");
+    } catch (...) {
+      failure = std::current_exception();
+    }
+    dem::agree_on_failure(*ranks, failure);
+  }
   int snapshot = 0;
   double next_snapshot = scene.output.snapshot_every > 0 ? state.time : std::numeric_limits<double>::infinity();
   LoopOptions loop;

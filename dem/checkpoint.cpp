@@ -1,6 +1,7 @@
 #include "dem/checkpoint.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <fstream>
 #include <unordered_map>
 
@@ -134,12 +135,22 @@ void split_fields(IO& io, I& image) {
 
 // The owned grains' share of the image, as bytes for rank 0.
 void put_owned(const State& s, std::vector<char>& grains, std::vector<char>& slots, std::vector<char>& pairs) {
-  for (std::size_t i = 0; i < s.owned(); ++i) put(grains, CheckpointGrain{grain_record(s, i), s.f[i], s.torque[i]});
+  for (std::size_t i = 0; i < s.owned(); ++i) {
+    CheckpointGrain g;
+    std::memset(static_cast<void*>(&g), 0, sizeof g);  // padding too: the same state, the same file
+    g.grain = grain_record(s, i), g.f = s.f[i], g.torque = s.torque[i];
+    put(grains, g);
+  }
   const NeighbourList& nl = s.neighbours;
   if (s.wall_slots.size() == nl.near_wall.size() * wall_slots_per_particle)
     for (std::size_t q = 0; q < nl.near_wall.size(); ++q) {
-      SlotRecord r{s.id[std::size_t(nl.near_wall[q])], {}};
-      std::copy_n(&s.wall_slots[q * wall_slots_per_particle], wall_slots_per_particle, r.slot);
+      SlotRecord r;
+      std::memset(static_cast<void*>(&r), 0, sizeof r);
+      r.id = s.id[std::size_t(nl.near_wall[q])];
+      for (int k = 0; k < wall_slots_per_particle; ++k) {
+        const WallSlot& slot = s.wall_slots[q * wall_slots_per_particle + std::size_t(k)];
+        r.slot[k].wall = slot.wall, r.slot[k].normal = slot.normal, r.slot[k].history = slot.history;
+      }
       put(slots, r);
     }
   for (const auto& of_grain : contact_histories(s))
@@ -214,25 +225,9 @@ std::string read_head(Reader& r, const Model& model, const std::filesystem::path
   return kind;
 }
 
-}  // namespace
-
-void write_checkpoint(const Model& model, const State& state, const std::filesystem::path& path) {
-  Writer w;
-  if (state.exchange) {
-    SplitImage image = image_of(state);
-    if (!writes_outputs(state)) return;
-    w.bytes.append(split_magic, sizeof split_magic);
-    w.bytes.append(model.hash);
-    split_fields(w, image);
-  } else {
-    w.bytes.append(magic, sizeof magic);
-    w.bytes.append(model.hash);
-    fields(w, state);
-  }
-  diefill::write_file_atomic(path, w.bytes);
-}
-
-State read_checkpoint(const Model& model, const std::filesystem::path& path, std::shared_ptr<Exchange> exchange) {
+// The file read on this rank: the whole state of a single-process checkpoint, or (with an
+// exchange) this rank's share of either kind.
+State read_whole_or_split(const Model& model, const std::filesystem::path& path, std::shared_ptr<Exchange> exchange) {
   Reader r{std::ifstream(path, std::ios::binary)};
   const bool split = read_head(r, model, path) == std::string(split_magic, sizeof split_magic);
   if (split && !exchange)
@@ -243,10 +238,53 @@ State read_checkpoint(const Model& model, const std::filesystem::path& path, std
   if (split) split_fields(r, image);
   else fields(r, s);
   if (!r.in) throw diefill::InputError(path.string(), "", "the checkpoint is truncated", "Start afresh");
+  if (exchange && !split && s.bodies.size() > 0)
+    throw diefill::InputError(path.string(), "", "a checkpoint of clump grains cannot be split over MPI ranks yet",
+                              "Resume it without mpirun");
   if (exchange) return share_of_image(split ? image : image_of(s), std::move(exchange));
   // The cross pairs' force buffers are scratch, refilled by the next force stage.
   s.cross_forces.force.assign(s.neighbours.cross_reverse.size(), Vec3::Zero());
   s.cross_forces.torque.assign(s.neighbours.cross_reverse.size(), Vec3::Zero());
+  return s;
+}
+
+}  // namespace
+
+void write_checkpoint(const Model& model, const State& state, const std::filesystem::path& path) {
+  Writer w;
+  if (!state.exchange) {
+    w.bytes.append(magic, sizeof magic);
+    w.bytes.append(model.hash);
+    fields(w, state);
+    diefill::write_file_atomic(path, w.bytes);
+    return;
+  }
+  SplitImage image = image_of(state);
+  std::exception_ptr failure;
+  if (writes_outputs(state)) {
+    try {
+      w.bytes.append(split_magic, sizeof split_magic);
+      w.bytes.append(model.hash);
+      split_fields(w, image);
+      diefill::write_file_atomic(path, w.bytes);
+    } catch (...) {
+      failure = std::current_exception();
+    }
+  }
+  agree_on_failure(*state.exchange, failure);
+}
+
+State read_checkpoint(const Model& model, const std::filesystem::path& path, std::shared_ptr<Exchange> exchange) {
+  if (!exchange) return read_whole_or_split(model, path, nullptr);
+  // Every rank reads the file; should one fail, all stop.
+  std::exception_ptr failure;
+  State s;
+  try {
+    s = read_whole_or_split(model, path, exchange);
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  agree_on_failure(*exchange, failure);
   return s;
 }
 

@@ -1,13 +1,20 @@
 #include "dem/distributed.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <numeric>
 #include <unordered_map>
+
+#include "core/error.hpp"
 
 namespace dem {
 
 GrainRecord grain_record(const State& s, std::size_t i) {
-  return {s.id[i], s.x[i], s.v[i], s.w[i], s.radius[i], s.mass[i], s.inertia[i], s.material[i], s.active[i]};
+  GrainRecord g;
+  std::memset(static_cast<void*>(&g), 0, sizeof g);  // padding too: the same state gives the same bytes
+  g.id = s.id[i], g.x = s.x[i], g.v = s.v[i], g.w = s.w[i];
+  g.radius = s.radius[i], g.mass = s.mass[i], g.inertia = s.inertia[i], g.material = s.material[i], g.active = s.active[i];
+  return g;
 }
 
 void append_grain(State& s, const GrainRecord& g) {
@@ -100,7 +107,21 @@ State gathered(const State& s) {
 void with_whole_state(const State& s, const std::function<void(const State&)>& use) {
   if (!s.exchange) return use(s);
   const State whole = gathered(s);
-  if (writes_outputs(s)) use(whole);
+  std::exception_ptr failure;
+  if (writes_outputs(s)) {
+    try {
+      use(whole);
+    } catch (...) {
+      failure = std::current_exception();
+    }
+  }
+  agree_on_failure(*s.exchange, failure);
+}
+
+void agree_on_failure(Exchange& exchange, const std::exception_ptr& failure) {
+  if (exchange.max(failure ? 1.0 : 0.0) == 0) return;
+  if (failure) std::rethrow_exception(failure);
+  throw diefill::InputError("", "", "another rank could not go on (it says why)", "See rank 0's message");
 }
 
 }  // namespace dem

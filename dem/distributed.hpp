@@ -4,6 +4,7 @@
 // outputs, and the contact histories that travel with grains, keyed by global ids. Every call
 // that takes a split state is collective: every rank makes it, in the same order. On a single
 // process (no exchange) each is the plain thing and makes no call.
+#include <exception>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -36,7 +37,11 @@ bool writes_outputs(const State& state);
 // step and the grains lost; no lists or contacts.
 State gathered(const State& state);
 // Calls `use` with the whole state where the outputs are written: the state itself on a single
-// process, the gathered one on rank 0 of a split.
+// process, the gathered one on rank 0 of a split. A failure there (a full disk) ends the call on
+// every rank: rank 0 rethrows it, the others throw InputError.
 void with_whole_state(const State& state, const std::function<void(const State&)>& use);
+// After a step some ranks may have failed in (writing a file, reading a cache): every rank learns
+// it; the failed ones rethrow their error, the others throw InputError. Collective.
+void agree_on_failure(Exchange& exchange, const std::exception_ptr& failure);
 
 }  // namespace dem

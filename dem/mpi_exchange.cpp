@@ -274,7 +274,9 @@ void MpiExchange::migrate(State& s) {
   double work = 0;
   for (const WeightedPoint& p : points) work += double(p.weight);
   const double heaviest = max(work), mean = sum(work) / ranks_;
-  const bool recut = cuts_.empty() || heaviest > 1.2 * mean;
+  // Also whenever the grains come without a list (shared anew, resumed, a round inserted): the
+  // cuts then follow from the grains alone, not from what the exchange did before.
+  const bool recut = cuts_.empty() || !listed || heaviest > 1.2 * mean;
   if (recut) partition(points);
 
   std::vector<std::vector<char>> out(static_cast<std::size_t>(ranks_));

@@ -205,7 +205,8 @@ std::vector<OldPair> carried_histories(State& s) {
 
 bool needs_rebuild(const Model& model, const State& s, double largest_shift2) {
   const NeighbourList& nl = s.neighbours;
-  if (nl.x_at_build.size() != s.size()) return true;
+  // No list (a state read back or shared anew): every rank rebuilds, one holding no grain too.
+  if (nl.x_at_build.size() != s.size() || nl.row_start.size() != s.size() + 1) return true;
   // How far any point of a wall has moved since the build: its origin's shift, plus for a
   // rotating wall the angle turned times its reach from the pivot (an arc bounds its chord).
   double wall_shift = 0;

@@ -4,6 +4,7 @@
 
 #include "core/error.hpp"
 #include "core/timer.hpp"
+#include "dem/distributed.hpp"
 #include "pipeline/census.hpp"
 #include "pipeline/outputs.hpp"
 #include "pipeline/plan.hpp"
@@ -33,23 +34,24 @@ class ThreadCount {
 };
 
 // Split over ranks, rank 0 prepares the walls first (building the fields into the cache) and the
-// others then read them from it; a failure there stops every rank.
+// others then read them from it; a failure on any rank stops every rank.
 FillWalls walls_rank0_first(const PipelineScene& s, const DieSource& source, const GrainSizing& grains, const ShoePlan& shoe,
                             const std::shared_ptr<dem::Exchange>& ranks) {
   if (!ranks || ranks->ranks() == 1) return prepare_walls(s, source, grains, shoe);
-  if (ranks->rank() == 0) {
+  FillWalls walls;
+  const auto prepare = [&] {
+    std::exception_ptr failure;
     try {
-      FillWalls walls = prepare_walls(s, source, grains, shoe);
-      ranks->max(0.0);
-      return walls;
+      walls = prepare_walls(s, source, grains, shoe);
     } catch (...) {
-      ranks->max(1.0);
-      throw;
+      failure = std::current_exception();
     }
-  }
-  if (ranks->max(0.0) > 0)
-    throw diefill::InputError(source.file.source, "", "rank 0 could not prepare the walls", "See rank 0's message");
-  return prepare_walls(s, source, grains, shoe);
+    return failure;
+  };
+  const bool first = ranks->rank() == 0;
+  dem::agree_on_failure(*ranks, first ? prepare() : nullptr);
+  dem::agree_on_failure(*ranks, first ? nullptr : prepare());
+  return walls;
 }
 
 }  // namespace

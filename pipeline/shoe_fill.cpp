@@ -170,17 +170,28 @@ std::optional<SettledShoe> fill_and_settle_shoe(const PipelineScene& s, const Fi
   const std::string key = settled_shoe_key(s, {walls.die.cache_key, grains, shoe, table_z, walls.powder}, dem::source_hash());
   const fs::path file = walls.cache / ("shoe-" + key + ".csv");
   SettledShoe out;
-  out.from_cache = fs::exists(file);
-  if (ranks) ranks->barrier();  // every rank has looked before any writes it
+  // Split over ranks, rank 0 looks and every rank goes by what it saw.
+  out.from_cache = ranks ? ranks->max(ranks->rank() == 0 && fs::exists(file) ? 1.0 : 0.0) > 0 : fs::exists(file);
   if (!out.from_cache) {
     const std::optional<SettledShoe> settled = settle_afresh(in, walls.die.name);
     if (!settled) return std::nullopt;
     fs::create_directories(walls.cache);
     dem::with_whole_state(settled->state, [&](const dem::State& whole) { dem::write_particles_csv(whole, file); });
-    if (ranks) ranks->barrier();
   }
   // Every run, cached or not, split or not, starts from the file's numbers.
-  out.state = dem::share_of(dem::read_particles_csv(file, walls.powder, walls.spec.materials[std::size_t(walls.powder)].density), ranks);
+  const auto read = [&] { return dem::read_particles_csv(file, walls.powder, walls.spec.materials[std::size_t(walls.powder)].density); };
+  if (!ranks) {
+    out.state = read();
+  } else {
+    std::exception_ptr failure;
+    try {
+      out.state = read();
+    } catch (...) {
+      failure = std::current_exception();
+    }
+    dem::agree_on_failure(*ranks, failure);
+  }
+  out.state = dem::share_of(std::move(out.state), ranks);
   out.requested = grains.count;
   out.inserted = std::size_t(ranks ? ranks->sum(std::int64_t(out.state.size())) : std::int64_t(out.state.size()));
   rest(out.state);

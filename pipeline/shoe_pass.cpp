@@ -21,7 +21,10 @@ std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& wal
   const dem::Model model = dem::compile_model(spec, state, s.source);
   fill.dt = model.dt;
   const fs::path checkpoint = dir / "checkpoint.bin";
-  if (resume && fs::exists(checkpoint)) {
+  // Split over ranks, rank 0 looks for the checkpoint and every rank goes by what it saw.
+  const bool found = state.exchange ? state.exchange->max(state.exchange->rank() == 0 && fs::exists(checkpoint) ? 1.0 : 0.0) > 0
+                                    : fs::exists(checkpoint);
+  if (resume && found) {
     state = dem::read_checkpoint(model, checkpoint, state.exchange);
     diefill::log::info("{}: resumed at t = {:.6g} s", walls.die.name, state.time);
   } else {
