@@ -111,26 +111,22 @@ int circle_segments(double radius, double chord_tolerance) {
 
 TriMesh ring_cavity(double outer_diameter, double inner_diameter, double depth,
                     double chord_tolerance) {
-  TriMesh m;
   const double ro = outer_diameter / 2, ri = inner_diameter / 2;
   const int n = circle_segments(ro, chord_tolerance);
+  if (ri <= 0) {
+    std::vector<Eigen::Vector2d> circle;
+    for (int i = 0; i < n; ++i) circle.emplace_back(ro * std::cos(2.0 * pi * i / n), ro * std::sin(2.0 * pi * i / n));
+    return extruded_cavity(circle, depth);
+  }
+  TriMesh m;
   const int outer_bottom = add_circle(m, ro, -depth, n);
   const int outer_top = add_circle(m, ro, 0.0, n);
   add_strip(m, outer_bottom, outer_top, n, false);  // normals away from the axis
-  if (ri > 0) {
-    const int inner_bottom = add_circle(m, ri, -depth, n);
-    const int inner_top = add_circle(m, ri, 0.0, n);
-    add_strip(m, inner_bottom, inner_top, n, true);  // normals towards the axis
-    add_strip(m, inner_top, outer_top, n, true);        // top annulus, normal +z
-    add_strip(m, inner_bottom, outer_bottom, n, false);  // floor annulus, normal -z
-  } else {
-    const int top_centre = int(m.vertices.size());
-    m.vertices.emplace_back(0.0, 0.0, 0.0);
-    const int bottom_centre = int(m.vertices.size());
-    m.vertices.emplace_back(0.0, 0.0, -depth);
-    add_fan(m, top_centre, outer_top, n, true);
-    add_fan(m, bottom_centre, outer_bottom, n, false);
-  }
+  const int inner_bottom = add_circle(m, ri, -depth, n);
+  const int inner_top = add_circle(m, ri, 0.0, n);
+  add_strip(m, inner_bottom, inner_top, n, true);      // normals towards the axis
+  add_strip(m, inner_top, outer_top, n, true);         // top annulus, normal +z
+  add_strip(m, inner_bottom, outer_bottom, n, false);  // floor annulus, normal -z
   return m;
 }
 
