@@ -186,11 +186,11 @@ SplitImage image_of(const State& s) {
   return image;
 }
 
-// This rank's share of the image (every ranks-th grain, as share_of), ready to step.
+// This rank's share of the image (share_indices, as share_of), ready to step.
 State share_of_image(const SplitImage& image, std::shared_ptr<Exchange> exchange) {
   State s;
   std::unordered_map<std::int64_t, std::size_t> index;
-  for (std::size_t k = std::size_t(exchange->rank()); k < image.grains.size(); k += std::size_t(exchange->ranks())) {
+  for (std::size_t k : share_indices(image.grains.size(), *exchange)) {
     const CheckpointGrain& g = image.grains[k];
     index.emplace(g.grain.id, s.size());
     append_grain(s, g.grain);

@@ -61,11 +61,15 @@ std::vector<std::vector<CarriedPair>> contact_histories(const State& s) {
   return pairs_of;
 }
 
+std::vector<std::size_t> share_indices(std::size_t count, const Exchange& exchange) {
+  std::vector<std::size_t> mine;
+  for (std::size_t k = std::size_t(exchange.rank()); k < count; k += std::size_t(exchange.ranks())) mine.push_back(k);
+  return mine;
+}
+
 State share_of(State whole, std::shared_ptr<Exchange> exchange) {
   if (!exchange) return whole;
-  std::vector<std::size_t> mine;
-  for (std::size_t i = std::size_t(exchange->rank()); i < whole.size(); i += std::size_t(exchange->ranks())) mine.push_back(i);
-  keep_grains(whole, mine);
+  keep_grains(whole, share_indices(whole.size(), *exchange));
   whole.neighbours = {};
   whole.wall_slots.clear();
   whole.lost = exchange->rank() == 0 ? whole.lost : 0;  // counted once, summed over the ranks
@@ -84,8 +88,7 @@ void add_share(State& s, const State& fresh) {
   s.neighbours = {};
   s.neighbours.near_wall = std::move(near_wall);
   s.carried_pairs = std::move(carried);
-  for (std::size_t k = std::size_t(s.exchange->rank()); k < fresh.size(); k += std::size_t(s.exchange->ranks()))
-    append_grain(s, grain_record(fresh, k));
+  for (std::size_t k : share_indices(fresh.size(), *s.exchange)) append_grain(s, grain_record(fresh, k));
 }
 
 bool writes_outputs(const State& s) { return !s.exchange || s.exchange->rank() == 0; }

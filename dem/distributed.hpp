@@ -22,8 +22,11 @@ void keep_grains(State& state, const std::vector<std::size_t>& keep);
 // two owned grains listed for both), or, before the first list is built, from carried_pairs.
 std::vector<std::vector<CarriedPair>> contact_histories(const State& state);
 
-// A rank's share of a state every rank holds whole (read from the same file): every ranks-th
-// grain, which migrate to their subdomains at the first build. No exchange: the whole state.
+// Which of `count` grains every rank holds alike (read from one file, drawn from one seed) this
+// rank takes: every ranks-th, from its rank on; they migrate to their subdomains at the first build.
+std::vector<std::size_t> share_indices(std::size_t count, const Exchange& exchange);
+
+// A rank's share of a state every rank holds whole (share_indices). No exchange: the whole state.
 State share_of(State whole, std::shared_ptr<Exchange> exchange);
 
 // Appends this rank's share of `fresh` (grains every rank drew alike) to a split state between
