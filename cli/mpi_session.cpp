@@ -27,7 +27,8 @@ MpiSession::MpiSession(int& argc, char**& argv) {
   if (!launched_by_mpi()) return;
   MPI_Init(&argc, &argv);
   session_exchange = dem::make_mpi_exchange();
-  // One progress line and one result: rank 0's. Errors still come from every rank.
+  // One progress line, one set of warnings and one result: rank 0's (a warning comes from values
+  // every rank shares). Errors still come from every rank.
   if (session_exchange->rank() != 0) diefill::log::set_level(diefill::log::Level::quiet);
 }
 MpiSession::~MpiSession() {

@@ -24,7 +24,7 @@ void write_info(std::string_view message) {
 void write_warning(std::string_view message) {
   std::lock_guard lock(g_mutex);
   g_warnings.emplace_back(message);
-  std::fprintf(stderr, "warning: %.*s\n", int(message.size()), message.data());
+  if (g_level != Level::quiet) std::fprintf(stderr, "warning: %.*s\n", int(message.size()), message.data());
 }
 
 void write_debug(std::string_view message) {

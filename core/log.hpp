@@ -1,5 +1,6 @@
 #pragma once
-// Minimal leveled logging to stderr. Warnings are also kept so that reports can list them.
+// Minimal leveled logging to stderr. Warnings are also kept so that reports can list them; quiet
+// (the ranks after the first of a split run, whose warnings are rank 0's) prints none.
 #include <fmt/core.h>
 
 #include <string>

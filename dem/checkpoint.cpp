@@ -14,7 +14,7 @@ namespace dem {
 namespace {
 
 constexpr char magic[8] = {'D', 'F', 'C', 'K', 'P', 'T', '0', '4'};
-constexpr char split_magic[8] = {'D', 'F', 'C', 'K', 'S', 'P', '0', '1'};
+constexpr char split_magic[8] = {'D', 'F', 'C', 'K', 'S', 'P', '0', '2'};
 
 struct Writer {
   std::string bytes;
@@ -100,7 +100,7 @@ void fields(IO& io, S& s) {
 
 // A run split over ranks, as one rank-count-free image: grains in id order with the forces of the
 // last step (the next step's first half kick needs them), their wall contacts and pair histories
-// keyed by global ids. Its lists are not kept: the first step after it builds them, and carries
+// keyed by global ids, and the clumps' bodies with their members' ids. Its lists are not kept: the first step after it builds them, and carries
 // the histories into them by id.
 struct CheckpointGrain {
   GrainRecord grain;
@@ -117,6 +117,7 @@ struct SplitImage {
   std::vector<CheckpointGrain> grains;
   std::vector<SlotRecord> slots;
   std::vector<CarriedPair> pairs;
+  BodiesImage bodies;
 };
 
 template <typename IO, typename I>
@@ -131,6 +132,8 @@ void split_fields(IO& io, I& image) {
   io.array(image.grains);
   io.array(image.slots);
   io.array(image.pairs);
+  io.array(image.bodies.bodies);
+  io.array(image.bodies.members);
 }
 
 // The owned grains' share of the image, as bytes for rank 0.
@@ -178,6 +181,7 @@ SplitImage image_of(const State& s) {
   image.grains = records<CheckpointGrain>(grains);
   image.slots = records<SlotRecord>(slots);
   image.pairs = records<CarriedPair>(pairs);
+  image.bodies = gathered_bodies(s);
   // In id order, so that the file is the same whichever rank held which grain.
   std::sort(image.grains.begin(), image.grains.end(), [](const auto& a, const auto& b) { return a.grain.id < b.grain.id; });
   std::sort(image.slots.begin(), image.slots.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
@@ -189,13 +193,14 @@ SplitImage image_of(const State& s) {
 // This rank's share of the image (share_indices, as share_of), ready to step.
 State share_of_image(const SplitImage& image, std::shared_ptr<Exchange> exchange) {
   State s;
-  std::unordered_map<std::int64_t, std::size_t> index;
-  for (std::size_t k : share_indices(image.grains.size(), *exchange)) {
-    const CheckpointGrain& g = image.grains[k];
-    index.emplace(g.grain.id, s.size());
+  for (const CheckpointGrain& g : image.grains) {
     append_grain(s, g.grain);
     s.f.back() = g.f, s.torque.back() = g.torque;
   }
+  append_bodies(s, image.bodies);
+  keep_grains(s, share_indices(s, *exchange));
+  std::unordered_map<std::int64_t, std::size_t> index;
+  for (std::size_t i = 0; i < s.size(); ++i) index.emplace(s.id[i], i);
   for (const SlotRecord& r : image.slots)
     if (const auto at = index.find(r.id); at != index.end()) {
       s.neighbours.near_wall.push_back(std::int32_t(at->second));
@@ -238,9 +243,6 @@ State read_whole_or_split(const Model& model, const std::filesystem::path& path,
   if (split) split_fields(r, image);
   else fields(r, s);
   if (!r.in) throw diefill::InputError(path.string(), "", "the checkpoint is truncated", "Start afresh");
-  if (exchange && !split && s.bodies.size() > 0)
-    throw diefill::InputError(path.string(), "", "a checkpoint of clump grains cannot be split over MPI ranks yet",
-                              "Resume it without mpirun");
   if (exchange) return share_of_image(split ? image : image_of(s), std::move(exchange));
   // The cross pairs' force buffers are scratch, refilled by the next force stage.
   s.cross_forces.force.assign(s.neighbours.cross_reverse.size(), Vec3::Zero());

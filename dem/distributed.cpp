@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 #include <numeric>
+#include <stdexcept>
 #include <unordered_map>
 
 #include "core/error.hpp"
@@ -24,6 +25,34 @@ void append_grain(State& s, const GrainRecord& g) {
   s.material.push_back(g.material), s.active.push_back(g.active), s.body.push_back(-1);
 }
 
+BodyRecord body_record(const Bodies& B, std::size_t b) {
+  BodyRecord r;
+  std::memset(static_cast<void*>(&r), 0, sizeof r);  // padding too: the same state gives the same bytes
+  r.x = B.x[b], r.v = B.v[b], r.l = B.l[b], r.f = B.f[b], r.torque = B.torque[b], r.inertia = B.inertia[b];
+  std::copy_n(B.q[b].coeffs().data(), 4, r.q);
+  r.mass = B.mass[b], r.volume = B.volume[b];
+  r.members = B.member_start[b + 1] - B.member_start[b];
+  r.active = B.active[b];
+  return r;
+}
+
+void append_body(State& s, const BodyRecord& r, const std::int32_t* member, const Vec3* offset) {
+  Bodies& B = s.bodies;
+  const auto b = std::int32_t(B.size());
+  Quat q;
+  std::copy_n(r.q, 4, q.coeffs().data());
+  B.x.push_back(r.x), B.v.push_back(r.v), B.q.push_back(q), B.l.push_back(r.l);
+  B.f.push_back(r.f), B.torque.push_back(r.torque), B.mass.push_back(r.mass), B.inertia.push_back(r.inertia);
+  B.volume.push_back(r.volume), B.active.push_back(r.active);
+  if (B.member_start.empty()) B.member_start.push_back(0);
+  for (std::int32_t k = 0; k < r.members; ++k) {
+    B.member.push_back(member[k]);
+    B.offset.push_back(offset[k]);
+    s.body[std::size_t(member[k])] = b;
+  }
+  B.member_start.push_back(std::int32_t(B.member.size()));
+}
+
 void keep_grains(State& s, const std::vector<std::size_t>& keep) {
   const auto select = [&](auto& a) {
     std::remove_reference_t<decltype(a)> kept;
@@ -31,8 +60,62 @@ void keep_grains(State& s, const std::vector<std::size_t>& keep) {
     for (std::size_t i : keep) kept.push_back(a[i]);
     a.swap(kept);
   };
+  const std::size_t before = s.size();
   select(s.id), select(s.x), select(s.v), select(s.w), select(s.f), select(s.torque);
   select(s.radius), select(s.mass), select(s.inertia), select(s.material), select(s.active), select(s.body);
+  if (s.bodies.size() == 0) return;
+  std::vector<std::int32_t> new_index(before, -1);
+  for (std::size_t k = 0; k < keep.size(); ++k) new_index[keep[k]] = std::int32_t(k);
+  const Bodies old = std::move(s.bodies);
+  s.bodies = {};
+  std::vector<std::int32_t> member;
+  for (std::size_t b = 0; b < old.size(); ++b) {
+    member.clear();
+    for (std::int32_t k = old.member_start[b]; k < old.member_start[b + 1]; ++k)
+      member.push_back(new_index[std::size_t(old.member[std::size_t(k)])]);
+    const auto kept = std::count_if(member.begin(), member.end(), [](std::int32_t i) { return i >= 0; });
+    if (kept == 0) continue;
+    if (std::size_t(kept) != member.size()) throw std::logic_error("keep_grains: a clump's members kept in part");
+    append_body(s, body_record(old, b), member.data(), &old.offset[std::size_t(old.member_start[b])]);
+  }
+}
+
+BodiesImage gathered_bodies(const State& s) {
+  const Bodies& B = s.bodies;
+  std::vector<char> mine;
+  for (std::size_t b = 0; b < B.size(); ++b) {
+    put(mine, body_record(B, b));
+    for (std::int32_t k = B.member_start[b]; k < B.member_start[b + 1]; ++k)
+      put(mine, MemberRecord{s.id[std::size_t(B.member[std::size_t(k)])], B.offset[std::size_t(k)]});
+  }
+  const std::vector<char> all = s.exchange ? s.exchange->gather(mine) : mine;
+  std::vector<std::pair<BodyRecord, std::vector<MemberRecord>>> bodies;
+  for (const char* at = all.data(); at < all.data() + all.size();) {
+    auto& [body, members] = bodies.emplace_back(take<BodyRecord>(at), std::vector<MemberRecord>{});
+    for (std::int32_t k = 0; k < body.members; ++k) members.push_back(take<MemberRecord>(at));
+  }
+  std::sort(bodies.begin(), bodies.end(), [](const auto& a, const auto& b) { return a.second[0].id < b.second[0].id; });
+  BodiesImage image;
+  for (const auto& [body, members] : bodies) {
+    image.bodies.push_back(body);
+    image.members.insert(image.members.end(), members.begin(), members.end());
+  }
+  return image;
+}
+
+void append_bodies(State& s, const BodiesImage& image) {
+  if (image.bodies.empty()) return;
+  std::unordered_map<std::int64_t, std::int32_t> index;
+  for (std::size_t i = 0; i < s.size(); ++i) index.emplace(s.id[i], std::int32_t(i));
+  std::vector<std::int32_t> member;
+  std::vector<Vec3> offset;
+  std::size_t at = 0;
+  for (const BodyRecord& body : image.bodies) {
+    member.clear(), offset.clear();
+    for (std::int32_t k = 0; k < body.members; ++k, ++at)
+      member.push_back(index.at(image.members[at].id)), offset.push_back(image.members[at].offset);
+    append_body(s, body, member.data(), offset.data());
+  }
 }
 
 std::vector<std::vector<CarriedPair>> contact_histories(const State& s) {
@@ -61,15 +144,26 @@ std::vector<std::vector<CarriedPair>> contact_histories(const State& s) {
   return pairs_of;
 }
 
-std::vector<std::size_t> share_indices(std::size_t count, const Exchange& exchange) {
+std::vector<std::size_t> share_indices(const State& whole, const Exchange& exchange) {
+  const Bodies& B = whole.bodies;
   std::vector<std::size_t> mine;
-  for (std::size_t k = std::size_t(exchange.rank()); k < count; k += std::size_t(exchange.ranks())) mine.push_back(k);
+  std::size_t unit = 0;
+  for (std::size_t i = 0; i < whole.size(); ++i) {
+    const std::int32_t b = whole.body[i];
+    const std::size_t first = b < 0 ? i : std::size_t(B.member[std::size_t(B.member_start[std::size_t(b)])]);
+    if (first != i) continue;  // a clump's other members go with its first
+    if (unit++ % std::size_t(exchange.ranks()) != std::size_t(exchange.rank())) continue;
+    if (b < 0) mine.push_back(i);
+    else
+      for (std::int32_t k = B.member_start[std::size_t(b)]; k < B.member_start[std::size_t(b) + 1]; ++k)
+        mine.push_back(std::size_t(B.member[std::size_t(k)]));
+  }
   return mine;
 }
 
 State share_of(State whole, std::shared_ptr<Exchange> exchange) {
   if (!exchange) return whole;
-  keep_grains(whole, share_indices(whole.size(), *exchange));
+  keep_grains(whole, share_indices(whole, *exchange));
   whole.neighbours = {};
   whole.wall_slots.clear();
   whole.lost = exchange->rank() == 0 ? whole.lost : 0;  // counted once, summed over the ranks
@@ -88,7 +182,17 @@ void add_share(State& s, const State& fresh) {
   s.neighbours = {};
   s.neighbours.near_wall = std::move(near_wall);
   s.carried_pairs = std::move(carried);
-  for (std::size_t k : share_indices(fresh.size(), *s.exchange)) append_grain(s, grain_record(fresh, k));
+  State share = fresh;
+  keep_grains(share, share_indices(fresh, *s.exchange));
+  const auto first = std::int32_t(s.size());
+  for (std::size_t i = 0; i < share.size(); ++i) append_grain(s, grain_record(share, i));
+  const Bodies& B = share.bodies;
+  std::vector<std::int32_t> member;
+  for (std::size_t b = 0; b < B.size(); ++b) {
+    member.clear();
+    for (std::int32_t k = B.member_start[b]; k < B.member_start[b + 1]; ++k) member.push_back(first + B.member[std::size_t(k)]);
+    append_body(s, body_record(B, b), member.data(), &B.offset[std::size_t(B.member_start[b])]);
+  }
 }
 
 bool writes_outputs(const State& s) { return !s.exchange || s.exchange->rank() == 0; }
@@ -104,6 +208,7 @@ State gathered(const State& s) {
   for (const char* at = all.data(); at < all.data() + all.size();) grains.push_back(take<GrainRecord>(at));
   std::sort(grains.begin(), grains.end(), [](const GrainRecord& a, const GrainRecord& b) { return a.id < b.id; });
   for (const GrainRecord& g : grains) append_grain(whole, g);
+  append_bodies(whole, gathered_bodies(s));
   return whole;
 }
 

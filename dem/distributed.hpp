@@ -15,16 +15,48 @@ namespace dem {
 
 GrainRecord grain_record(const State& state, std::size_t i);
 void append_grain(State& state, const GrainRecord& grain);
-// Keeps the grains listed in `keep`, in that order (their per-grain arrays only).
+
+// A clump's body as it travels between ranks (a migration, the gathered state, a split
+// checkpoint); its members travel as grains. A clump is never split: its members always live on
+// the rank that owns its body, so that the body's force is summed from owned grains.
+struct BodyRecord {
+  Vec3 x, v, l, f, torque, inertia;
+  double q[4];  // the orientation's coefficients x, y, z, w
+  double mass, volume;
+  std::int32_t members;
+  std::uint8_t active;
+};
+// A member of a body, named by its global id, with its offset in the body's principal frame.
+struct MemberRecord {
+  std::int64_t id;
+  Vec3 offset;
+};
+BodyRecord body_record(const Bodies& bodies, std::size_t b);
+// Appends a body whose members, in template order, are the grains `member` already in `state`.
+void append_body(State& state, const BodyRecord& body, const std::int32_t* member, const Vec3* offset);
+
+// Keeps the grains listed in `keep`, in that order (their per-grain arrays), and the bodies
+// whose members are all kept (a body is kept or dropped whole).
 void keep_grains(State& state, const std::vector<std::size_t>& keep);
+
+// Every rank's bodies on rank 0 (empty elsewhere), in the order of their first member's id:
+// the order in which a single process created them. Collective.
+struct BodiesImage {
+  std::vector<BodyRecord> bodies;
+  std::vector<MemberRecord> members;  // each body's, in body order
+};
+BodiesImage gathered_bodies(const State& state);
+// Appends the image's bodies to a state that holds their members (found by id).
+void append_bodies(State& state, const BodiesImage& image);
 
 // Per owned grain, the histories of its pairs as it sees them: from the neighbour list (a pair of
 // two owned grains listed for both), or, before the first list is built, from carried_pairs.
 std::vector<std::vector<CarriedPair>> contact_histories(const State& state);
 
-// Which of `count` grains every rank holds alike (read from one file, drawn from one seed) this
-// rank takes: every ranks-th, from its rank on; they migrate to their subdomains at the first build.
-std::vector<std::size_t> share_indices(std::size_t count, const Exchange& exchange);
+// Which grains of a state every rank holds alike (read from one file, drawn from one seed) this
+// rank takes: every ranks-th unit (a free grain, or a clump with all its members), from its rank
+// on; they migrate to their subdomains at the first build.
+std::vector<std::size_t> share_indices(const State& whole, const Exchange& exchange);
 
 // A rank's share of a state every rank holds whole (share_indices). No exchange: the whole state.
 State share_of(State whole, std::shared_ptr<Exchange> exchange);
@@ -36,8 +68,8 @@ void add_share(State& state, const State& fresh);
 
 // Rank 0 (or a single process) writes the outputs.
 bool writes_outputs(const State& state);
-// The owned grains of every rank in id order, on rank 0 (empty elsewhere), with the time, the
-// step and the grains lost; no lists or contacts.
+// The owned grains of every rank in id order and their clumps' bodies (gathered_bodies), on rank
+// 0 (empty elsewhere), with the time, the step and the grains lost; no lists or contacts.
 State gathered(const State& state);
 // Calls `use` with the whole state where the outputs are written: the state itself on a single
 // process, the gathered one on rank 0 of a split. A failure there (a full disk) ends the call on

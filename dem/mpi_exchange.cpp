@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <limits>
 
-#include "core/error.hpp"
 #include "dem/distributed.hpp"
 #include "dem/model.hpp"
 #include "dem/state.hpp"
@@ -247,26 +246,33 @@ void MpiExchange::partition(const std::vector<WeightedPoint>& local) {
 }
 
 void MpiExchange::redistribute(const Model& model, State& s) {
-  if (s.bodies.size() > 0)
-    throw diefill::InputError("mpirun", "ranks", "clump grains are not split over MPI ranks yet",
-                              "Run clump grains on one process (threads), or use spheres");
   migrate(s);
   send_ghosts(model, s);
 }
 
+// Grains move by units: a free grain goes where its centre lies, a clump where its body's centre
+// lies, with all its members (the body's force is summed from its members' on one rank).
 void MpiExchange::migrate(State& s) {
   const std::size_t owned = s.owned();
   const NeighbourList& nl = s.neighbours;
+  const Bodies& B = s.bodies;
   const bool listed = nl.row_start.size() == s.size() + 1;
   // What each owned grain takes along: its pairs' histories (as it sees them), its wall contacts.
   const std::vector<std::vector<CarriedPair>> pairs_of = contact_histories(s);
   std::vector<const WallSlot*> slots_of(owned, nullptr);
-  std::vector<WeightedPoint> points;
-  // The cost of a grain: its listed pairs, and itself.
-  for (std::size_t i = 0; i < owned; ++i)
-    if (s.active[i]) points.push_back({s.x[i], 1 + (listed ? std::int64_t(nl.row_start[i + 1] - nl.row_start[i]) : 0)});
   if (s.wall_slots.size() == nl.near_wall.size() * wall_slots_per_particle)
     for (std::size_t q = 0; q < nl.near_wall.size(); ++q) slots_of[std::size_t(nl.near_wall[q])] = &s.wall_slots[q * wall_slots_per_particle];
+  // The cost of a grain: its listed pairs, and itself; a clump's, its members' together.
+  const auto cost = [&](std::size_t i) { return 1 + (listed ? std::int64_t(nl.row_start[i + 1] - nl.row_start[i]) : 0); };
+  std::vector<WeightedPoint> points;
+  for (std::size_t i = 0; i < owned; ++i)
+    if (s.active[i] && s.body[i] < 0) points.push_back({s.x[i], cost(i)});
+  for (std::size_t b = 0; b < B.size(); ++b)
+    if (B.active[b]) {
+      std::int64_t weight = 0;
+      for (std::int32_t k = B.member_start[b]; k < B.member_start[b + 1]; ++k) weight += cost(std::size_t(B.member[std::size_t(k)]));
+      points.push_back({B.x[b], weight});
+    }
 
   // Cut anew at the first call, or when the heaviest rank carries more than 1.2 times the mean.
   double work = 0;
@@ -285,31 +291,54 @@ void MpiExchange::migrate(State& s) {
   // Between two cuts a grain moves less than the ghost reach between rebuilds, so it migrates to a
   // neighbour; after a cut, or should one not, every rank may send to every other.
   bool beyond_neighbours = recut;
-  const auto carry = [&](std::size_t i) {
+  const auto stay = [&](std::size_t i) {
+    keep.push_back(i);
     if (slots_of[i]) {
       near.push_back(std::int32_t(keep.size() - 1));
       slots.insert(slots.end(), slots_of[i], slots_of[i] + wall_slots_per_particle);
     }
     carried.insert(carried.end(), pairs_of[i].begin(), pairs_of[i].end());
   };
-  for (std::size_t i = 0; i < owned; ++i) {
-    // A lost grain stays where it was lost: it takes part in nothing.
-    const int to = s.active[i] ? owner(s.x[i]) : rank_;
-    if (to == rank_) {
-      keep.push_back(i);
-      carry(i);
-      continue;
-    }
-    if (!std::binary_search(neighbours_.begin(), neighbours_.end(), to)) beyond_neighbours = true;
-    std::vector<char>& b = out[std::size_t(to)];
+  const auto send = [&](std::vector<char>& b, std::size_t i) {
     put(b, Migrant{grain_record(s, i), std::int32_t(pairs_of[i].size()), std::uint8_t(slots_of[i] ? 1 : 0)});
     if (slots_of[i])
       for (int k = 0; k < wall_slots_per_particle; ++k) put(b, slots_of[i][k]);
     for (const CarriedPair& c : pairs_of[i]) put(b, c);
+  };
+  // A unit's destination; a lost grain stays where it was lost: it takes part in nothing.
+  const auto destination = [&](bool active, const Vec3& x) {
+    const int to = active ? owner(x) : rank_;
+    if (to != rank_ && !std::binary_search(neighbours_.begin(), neighbours_.end(), to)) beyond_neighbours = true;
+    return to;
+  };
+  // Each unit in the buffer: its member count (0: a free grain), for a clump its body and offsets,
+  // then its grains.
+  for (std::size_t i = 0; i < owned; ++i) {
+    if (s.body[i] >= 0) continue;
+    const int to = destination(s.active[i] != 0, s.x[i]);
+    if (to == rank_) {
+      stay(i);
+      continue;
+    }
+    put(out[std::size_t(to)], std::int32_t{0});
+    send(out[std::size_t(to)], i);
+  }
+  for (std::size_t b = 0; b < B.size(); ++b) {
+    const int to = destination(B.active[b] != 0, B.x[b]);
+    const auto first = B.member_start[b], last = B.member_start[b + 1];
+    if (to == rank_) {
+      for (std::int32_t k = first; k < last; ++k) stay(std::size_t(B.member[std::size_t(k)]));
+      continue;
+    }
+    std::vector<char>& buffer = out[std::size_t(to)];
+    put(buffer, std::int32_t(last - first));
+    put(buffer, body_record(B, b));
+    for (std::int32_t k = first; k < last; ++k) put(buffer, B.offset[std::size_t(k)]);
+    for (std::int32_t k = first; k < last; ++k) send(buffer, std::size_t(B.member[std::size_t(k)]));
   }
   const std::vector<char> received = max(beyond_neighbours ? 1.0 : 0.0) > 0 ? all_to_all(out) : with_neighbours(out);
   keep_grains(s, keep);
-  for (const char* at = received.data(); at < received.data() + received.size();) {
+  const auto arrive = [&](const char*& at) {
     const Migrant m = take<Migrant>(at);
     append_grain(s, m.grain);
     if (m.near_wall) {
@@ -317,6 +346,20 @@ void MpiExchange::migrate(State& s) {
       for (int k = 0; k < wall_slots_per_particle; ++k) slots.push_back(take<WallSlot>(at));
     }
     for (std::int32_t k = 0; k < m.pairs; ++k) carried.push_back(take<CarriedPair>(at));
+  };
+  std::vector<Vec3> offset;
+  std::vector<std::int32_t> member;
+  for (const char* at = received.data(); at < received.data() + received.size();) {
+    const auto members = take<std::int32_t>(at);
+    if (members == 0) {
+      arrive(at);
+      continue;
+    }
+    const BodyRecord body = take<BodyRecord>(at);
+    offset.clear(), member.clear();
+    for (std::int32_t k = 0; k < members; ++k) offset.push_back(take<Vec3>(at));
+    for (std::int32_t k = 0; k < members; ++k) arrive(at), member.push_back(std::int32_t(s.size() - 1));
+    append_body(s, body, member.data(), offset.data());
   }
   s.ghosts = 0;
   s.neighbours.near_wall.swap(near);
@@ -325,15 +368,22 @@ void MpiExchange::migrate(State& s) {
 }
 
 // Every owned grain within reach of another rank's subdomain is copied there: reach 2 r_max +
-// skin, the farthest a listed partner of a grain inside that subdomain can be at the build.
+// skin, the farthest a listed partner of a grain inside that subdomain can be at the build, and
+// with clumps the farthest a member lies from its body's centre, which alone lies in the box.
 void MpiExchange::send_ghosts(const Model& model, State& s) {
-  double r_max = 0;
+  double r_max = 0, outside = 0;
   for (std::size_t i = 0; i < s.size(); ++i) r_max = std::max(r_max, s.radius[i]);
-  const double reach = 2 * max(r_max) + model.skin;
-  // The owned grains lie in this rank's box: only boxes within reach of it can want them.
+  const Bodies& B = s.bodies;
+  for (std::size_t b = 0; b < B.size(); ++b)
+    for (std::int32_t k = B.member_start[b]; k < B.member_start[b + 1]; ++k)
+      outside = std::max(outside, (s.x[std::size_t(B.member[std::size_t(k)])] - B.x[b]).norm());
+  outside = max(outside);
+  const double reach = 2 * max(r_max) + model.skin + outside;
+  // The owned grains lie in this rank's box, or as far outside it as a member from its centre:
+  // only boxes within reach of that can want them.
   neighbours_.clear();
   for (int r = 0; r < ranks_; ++r)
-    if (r != rank_ && boxes_[std::size_t(r)].distance(boxes_[std::size_t(rank_)]) < reach) neighbours_.push_back(r);
+    if (r != rank_ && boxes_[std::size_t(r)].distance(boxes_[std::size_t(rank_)]) < reach + outside) neighbours_.push_back(r);
   send_.assign(std::size_t(ranks_), {});
   std::vector<std::vector<char>> out(static_cast<std::size_t>(ranks_));
   for (std::size_t i = 0; i < s.size(); ++i) {

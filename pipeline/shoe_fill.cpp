@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <numbers>
 
-#include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/sha256.hpp"
 #include "dem/distributed.hpp"
@@ -78,23 +77,26 @@ std::size_t insert_round(const Insertion& in, dem::State& bed, std::size_t count
   if (region.box.hi.z() <= region.box.lo.z()) return 0;
   const std::uint64_t seed = in.scene.seed + std::uint64_t(round) * 7919;  // round 0: the scene's seed, as always
   const double density = in.walls.spec.materials[std::size_t(in.walls.powder)].density;
-  if (in.clump)
-    return dem::insert_clumps(bed, region, *in.clump, in.grains.diameter / in.clump->equivalent_diameter_m, count,
-                              in.walls.powder, density, seed, before.next_id);
-  dem::InsertRequest request;
-  request.count = count;
-  request.radius = 0.5 * in.grains.diameter;
-  request.radius_spread = in.scene.diameter_spread;
-  request.material = in.walls.powder;
-  request.density = density;
-  request.seed = seed;
-  request.first_id = before.next_id;
-  request.max_solid_fraction = insertion_solid_fraction;
-  if (!bed.exchange) return dem::insert_spheres(bed, region, request);
+  const auto draw = [&](dem::State& into) {
+    if (in.clump)
+      return dem::insert_clumps(into, region, *in.clump, in.grains.diameter / in.clump->equivalent_diameter_m, count,
+                                in.walls.powder, density, seed, before.next_id);
+    dem::InsertRequest request;
+    request.count = count;
+    request.radius = 0.5 * in.grains.diameter;
+    request.radius_spread = in.scene.diameter_spread;
+    request.material = in.walls.powder;
+    request.density = density;
+    request.seed = seed;
+    request.first_id = before.next_id;
+    request.max_solid_fraction = insertion_solid_fraction;
+    return dem::insert_spheres(into, region, request);
+  };
+  if (!bed.exchange) return draw(bed);
   // Split over ranks, every rank draws the same new grains (the box lies above the bed, so the
   // grains below cannot change a draw) and takes its share of them.
   dem::State fresh;
-  const std::size_t added = dem::insert_spheres(fresh, region, request);
+  const std::size_t added = draw(fresh);
   dem::add_share(bed, fresh);
   return added;
 }
@@ -159,9 +161,6 @@ std::optional<SettledShoe> fill_and_settle_shoe(const PipelineScene& s, const Fi
   Insertion in{s, walls, grains, shoe, table_z, std::nullopt, ranks};
   // Clumps are settled afresh each run: the particles file does not hold their poses.
   if (!s.shape_mesh.empty()) {
-    if (ranks && ranks->ranks() > 1)
-      throw diefill::InputError(s.source, "powder.shape", "clump grains are not split over MPI ranks yet",
-                                "Run clump grains without mpirun (on threads), or use spheres");
     in.clump = build_clump({s.shape_mesh, mesh::parse_unit(s.shape_units, "powder.shape.units"), s.shape_tolerance, 64, s.seed});
     std::optional<SettledShoe> settled = settle_afresh(in, walls.die.name);
     if (settled) rest(settled->state);

@@ -1,11 +1,12 @@
 // diefill itself under mpirun (docs/ARCHITECTURE.md, "Domain decomposition"): the pipeline on the
 // ring over 2 and 3 ranks fills as one process does and repeats its bits on the same rank count,
-// a checkpoint that 2 ranks wrote resumes on 3, and an overlap past the limit stops every rank
+// a checkpoint that 2 ranks wrote resumes on 3, clump grains split too, and an overlap past the limit stops every rank
 // with exit status 3 and a checkpoint.
 #include <fmt/core.h>
 
 #include <chrono>
 #include <map>
+#include <numbers>
 #include <nlohmann/json.hpp>
 
 #include "support.hpp"
@@ -101,6 +102,30 @@ TEST(MpiRun, ACheckpointOfTwoRanksResumesOnThree) {
   EXPECT_NEAR(report["fill"]["fill_ratio"].get<double>(), uninterrupted["fill"]["fill_ratio"].get<double>(),
               4 * single_process_fill_sd);
   EXPECT_FALSE(fs::exists(dir / "ring" / "checkpoint.bin")) << "a finished run removes its checkpoint";
+}
+
+// Capsule grains as rigid clumps, settled in the shoe and poured into the ring over two ranks:
+// every clump lives on one rank, so the census adds up (every grain counted once, none lost), the
+// binned volume is the grains' true volume, and rank 0 alone reports and warns.
+TEST(MpiRun, ClumpGrainsFillTheRingOverTwoRanks) {
+  REQUIRE_SHARED_MESHES();
+  const std::string capsule = (test::shared_meshes() / "grains" / "capsule_trimesh.obj").string();
+  const test::Run run = mpirun(2, "run " + ring + " --set powder.shape.mesh=\"" + capsule +
+                                      "\" --set powder.shape.tolerance=0.05 --out " + (suite_out() / "clumps").string());
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_EQ(count(run.output, "ring: report "), 1u) << run.output;
+  EXPECT_LE(count(run.output, "warning: ring: the shoe holds"), 1u) << "rank 0 alone warns:\n" << run.output;
+  const nlohmann::json r = nlohmann::json::parse(test::read_text(suite_out() / "clumps" / "ring" / "report.json"));
+  const nlohmann::json& p = r["particles"];
+  EXPECT_EQ(r["timing"]["ranks"], 2);
+  EXPECT_EQ(p["lost"].get<std::int64_t>(), 0);
+  EXPECT_GT(p["in_cavity"].get<std::int64_t>(), 100);
+  EXPECT_EQ(p["inserted"].get<std::int64_t>(),
+            p["in_cavity"].get<std::int64_t>() + p["in_shoe"].get<std::int64_t>() + p["elsewhere"].get<std::int64_t>());
+  EXPECT_GT(r["powder"]["spheres_per_grain"].get<int>(), 1);
+  const double d = r["powder"]["grain_diameter_m"].get<double>();
+  const double expected = double(p["inserted"].get<std::int64_t>()) * std::numbers::pi / 6 * d * d * d;
+  EXPECT_NEAR(r["powder"]["grain_volume_m3"].get<double>(), expected, 1e-9 * expected);
 }
 
 // Two grains of 200 overlap by 1.4 radii at the start, on one rank: every rank stops at the first
