@@ -133,7 +133,8 @@ int main(int argc, char** argv) {
   bool verbose = false;
   root.add_flag("-v,--verbose", verbose, "Log each stage with its time");
   root.parse_complete_callback([&] {
-    if (verbose) diefill::log::set_level(diefill::log::Level::verbose);
+    // Ranks after the first of a split run stay quiet (mpi_session.cpp), verbose or not.
+    if (verbose && diefill::log::level() != diefill::log::Level::quiet) diefill::log::set_level(diefill::log::Level::verbose);
   });
   std::function<int()> action;
   app::SdfCommand sdf;

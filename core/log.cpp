@@ -21,10 +21,10 @@ void write_info(std::string_view message) {
   std::fprintf(stderr, "%.*s\n", int(message.size()), message.data());
 }
 
-void write_warning(std::string_view message) {
+void write_warning(std::string_view message, bool even_when_quiet) {
   std::lock_guard lock(g_mutex);
   g_warnings.emplace_back(message);
-  if (g_level != Level::quiet) std::fprintf(stderr, "warning: %.*s\n", int(message.size()), message.data());
+  if (g_level != Level::quiet || even_when_quiet) std::fprintf(stderr, "warning: %.*s\n", int(message.size()), message.data());
 }
 
 void write_debug(std::string_view message) {

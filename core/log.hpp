@@ -14,7 +14,7 @@ void set_level(Level level);
 Level level();
 
 void write_info(std::string_view message);
-void write_warning(std::string_view message);
+void write_warning(std::string_view message, bool even_when_quiet = false);
 void write_debug(std::string_view message);
 // Every warning written since the last call, oldest first; clears the list.
 std::vector<std::string> take_warnings();
@@ -26,6 +26,11 @@ void info(fmt::format_string<Args...> f, Args&&... args) {
 template <typename... Args>
 void warn(fmt::format_string<Args...> f, Args&&... args) {
   write_warning(fmt::format(f, std::forward<Args>(args)...));
+}
+// A warning about this process alone (a file it read), printed even where the level is quiet.
+template <typename... Args>
+void warn_here(fmt::format_string<Args...> f, Args&&... args) {
+  write_warning(fmt::format(f, std::forward<Args>(args)...), true);
 }
 template <typename... Args>
 void debug(fmt::format_string<Args...> f, Args&&... args) {

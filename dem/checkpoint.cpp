@@ -4,6 +4,7 @@
 #include <cstring>
 #include <fstream>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
@@ -216,12 +217,29 @@ State share_of_image(const SplitImage& image, std::shared_ptr<Exchange> exchange
   return s;
 }
 
+// Every clump names members that the image holds, at least one each.
+bool bodies_match_grains(const SplitImage& image) {
+  std::unordered_set<std::int64_t> ids;
+  for (const CheckpointGrain& g : image.grains) ids.insert(g.grain.id);
+  std::size_t members = 0;
+  for (const BodyRecord& b : image.bodies.bodies) {
+    if (b.members <= 0) return false;
+    members += std::size_t(b.members);
+  }
+  if (members != image.bodies.members.size()) return false;
+  return std::all_of(image.bodies.members.begin(), image.bodies.members.end(), [&](const MemberRecord& m) { return ids.count(m.id) > 0; });
+}
+
 std::string read_head(Reader& r, const Model& model, const std::filesystem::path& path) {
   char head[sizeof magic];
   std::string hash(model.hash.size(), '\0');
   r.in.read(head, sizeof head);
   r.in.read(hash.data(), std::streamsize(hash.size()));
   const std::string kind(head, sizeof head);
+  if (r.in && kind != std::string(magic, sizeof magic) && kind != std::string(split_magic, sizeof split_magic) &&
+      (kind.starts_with("DFCKPT") || kind.starts_with("DFCKSP")))
+    throw diefill::InputError(path.string(), "", "the checkpoint was written by another version of diefill",
+                              "Start afresh (without --resume)");
   if (!r.in || (kind != std::string(magic, sizeof magic) && kind != std::string(split_magic, sizeof split_magic)))
     throw diefill::InputError(path.string(), "", "not a diefill checkpoint", "Name a checkpoint file diefill wrote");
   if (hash != model.hash)
@@ -243,6 +261,8 @@ State read_whole_or_split(const Model& model, const std::filesystem::path& path,
   if (split) split_fields(r, image);
   else fields(r, s);
   if (!r.in) throw diefill::InputError(path.string(), "", "the checkpoint is truncated", "Start afresh");
+  if (split && !bodies_match_grains(image))
+    throw diefill::InputError(path.string(), "", "the checkpoint's clumps name grains it does not hold (a damaged file)", "Start afresh");
   if (exchange) return share_of_image(split ? image : image_of(s), std::move(exchange));
   // The cross pairs' force buffers are scratch, refilled by the next force stage.
   s.cross_forces.force.assign(s.neighbours.cross_reverse.size(), Vec3::Zero());

@@ -62,7 +62,8 @@ class Exchange {
   // Every rank's bytes, concatenated in rank order, on rank 0 (empty elsewhere).
   virtual std::vector<char> gather(const std::vector<char>& local) = 0;
   virtual void barrier() = 0;
-  // At a neighbour rebuild: owned grains move to the rank whose subdomain holds them (cut anew
+  // At a neighbour rebuild: owned grains move to the rank whose subdomain holds them (a clump's
+  // members all go where its body's centre lies; cut anew
   // when the heaviest rank carries more than 1.2 times the mean work), with their pair contact
   // histories (left in state.carried_pairs, keyed by global ids) and their wall contacts; then
   // every rank receives as ghosts the other ranks' grains within reach of its subdomain.

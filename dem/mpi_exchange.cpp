@@ -3,10 +3,10 @@
 #include <mpi.h>
 
 #include <algorithm>
-#include <limits>
 
 #include "dem/distributed.hpp"
 #include "dem/model.hpp"
+#include "dem/rcb_partition.hpp"
 #include "dem/state.hpp"
 
 namespace dem {
@@ -23,27 +23,6 @@ struct Migrant {
 struct GhostMotion {
   Vec3 x, v, w;
 };
-// A grain as the partitioner weighs it: itself and its listed pairs.
-struct WeightedPoint {
-  Vec3 x;
-  std::int64_t weight;
-};
-
-// The subdomains: a tree of cuts, each leaf a rank; its boxes tile all of space.
-struct Cut {
-  int axis = -1;  // -1: a leaf
-  double at = 0;
-  int below = -1, above = -1, rank = -1;
-};
-
-struct Box {
-  Vec3 lo = Vec3::Constant(-std::numeric_limits<double>::infinity()), hi = -lo;
-  double distance(const Vec3& p) const {
-    return (lo - p).cwiseMax(p - hi).cwiseMax(0.0).norm();
-  }
-  double distance(const Box& other) const { return (lo - other.hi).cwiseMax(other.lo - hi).cwiseMax(0.0).norm(); }
-};
-
 class MpiExchange final : public Exchange {
  public:
   MpiExchange() {
@@ -89,21 +68,11 @@ class MpiExchange final : public Exchange {
   // The same when only the neighbouring subdomains' buffers can hold anything: messages to and
   // from them alone, so that a step's cost does not grow with the number of ranks.
   std::vector<char> with_neighbours(const std::vector<std::vector<char>>& out) const;
-  void partition(const std::vector<WeightedPoint>& local);
-  int owner(const Vec3& x) const {
-    int node = 0;
-    while (cuts_[std::size_t(node)].axis >= 0) {
-      const Cut& c = cuts_[std::size_t(node)];
-      node = x[c.axis] < c.at ? c.below : c.above;
-    }
-    return cuts_[std::size_t(node)].rank;
-  }
   void migrate(State& s);
   void send_ghosts(const Model& model, State& s);
 
   int rank_ = 0, ranks_ = 1;
-  std::vector<Cut> cuts_;
-  std::vector<Box> boxes_;                   // [ranks]
+  RcbPartition cuts_;
   std::vector<std::vector<std::int32_t>> send_;  // [ranks] owned grains ghosted there, in send order
   // The other ranks whose boxes lie within ghost reach of this one's, ascending: the only ones a
   // ghost goes to or a grain migrates to between two cuts.
@@ -158,93 +127,6 @@ std::vector<char> MpiExchange::with_neighbours(const std::vector<std::vector<cha
   return received;
 }
 
-// Recursive coordinate bisection computed by all ranks together, level by level (as Zoltan's RCB
-// does), each rank looking at its own grains only: a cut goes across the longest extent of its
-// grains and is placed by bisecting the coordinate until the weight below it reaches the share of
-// the ranks below it. Extents are reduced by minimum and weights as integers, so that every rank
-// and every run finds the same cuts.
-void MpiExchange::partition(const std::vector<WeightedPoint>& local) {
-  struct Node {
-    int lo, hi, tree;  // ranks [lo, hi); its index in cuts_
-    Box box;
-  };
-  cuts_.assign(1, Cut{});
-  boxes_.assign(std::size_t(ranks_), Box{});
-  std::vector<Node> level;
-  if (ranks_ > 1) level.push_back({0, ranks_, 0, Box{}});
-  else cuts_[0].rank = 0;
-  std::vector<int> node_of(local.size(), ranks_ > 1 ? 0 : -1);  // the grain's node in `level`; -1: in a leaf
-  constexpr int bisection_steps = 52;         // to the last bit of a double's mantissa
-  while (!level.empty()) {
-    const std::size_t m = level.size();
-    // Per node: lows and negated highs of the grains (one minimum), and their total weight.
-    std::vector<double> extent(6 * m, std::numeric_limits<double>::infinity());
-    std::vector<std::int64_t> total(m, 0);
-    for (std::size_t k = 0; k < local.size(); ++k) {
-      if (node_of[k] < 0) continue;
-      const std::size_t n = std::size_t(node_of[k]);
-      for (int a = 0; a < 3; ++a)
-        extent[6 * n + std::size_t(a)] = std::min(extent[6 * n + std::size_t(a)], local[k].x[a]),
-        extent[6 * n + 3 + std::size_t(a)] = std::min(extent[6 * n + 3 + std::size_t(a)], -local[k].x[a]);
-      total[n] += local[k].weight;
-    }
-    MPI_Allreduce(MPI_IN_PLACE, extent.data(), int(6 * m), MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
-    MPI_Allreduce(MPI_IN_PLACE, total.data(), int(m), MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD);
-    std::vector<int> axis(m, 0);
-    std::vector<double> low(m), high(m);  // the bisection's interval
-    for (std::size_t n = 0; n < m; ++n) {
-      const Vec3 lo(extent[6 * n], extent[6 * n + 1], extent[6 * n + 2]), hi(-extent[6 * n + 3], -extent[6 * n + 4], -extent[6 * n + 5]);
-      if (total[n] > 0) (hi - lo).maxCoeff(&axis[n]);
-      // No grains: any cut will do.
-      low[n] = total[n] > 0 ? lo[axis[n]] : std::clamp(0.0, level[n].box.lo[0], level[n].box.hi[0]);
-      high[n] = total[n] > 0 ? hi[axis[n]] : low[n];
-    }
-    std::vector<std::int64_t> below(m);
-    for (int step = 0; step < bisection_steps; ++step) {
-      std::fill(below.begin(), below.end(), 0);
-      for (std::size_t k = 0; k < local.size(); ++k)
-        if (const int n = node_of[k]; n >= 0 && local[k].x[axis[std::size_t(n)]] < 0.5 * (low[std::size_t(n)] + high[std::size_t(n)]))
-          below[std::size_t(n)] += local[k].weight;
-      MPI_Allreduce(MPI_IN_PLACE, below.data(), int(m), MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD);
-      for (std::size_t n = 0; n < m; ++n) {
-        const Node& node = level[n];
-        const int mid = node.lo + (node.hi - node.lo) / 2;
-        const double at = 0.5 * (low[n] + high[n]);
-        (below[n] * (node.hi - node.lo) < total[n] * (mid - node.lo) ? low[n] : high[n]) = at;
-      }
-    }
-    std::vector<Node> next;
-    std::vector<int> child(2 * m, -1);  // per node: its lower and upper child's index in `next`
-    for (std::size_t n = 0; n < m; ++n) {
-      const Node& node = level[n];
-      const int mid = node.lo + (node.hi - node.lo) / 2;
-      Cut& cut = cuts_[std::size_t(node.tree)];
-      cut.axis = axis[n], cut.at = high[n];
-      Box lower = node.box, upper = node.box;
-      lower.hi[cut.axis] = upper.lo[cut.axis] = cut.at;
-      const std::pair<int, int> halves[2] = {{node.lo, mid}, {mid, node.hi}};
-      for (int side = 0; side < 2; ++side) {
-        const int tree = int(cuts_.size());
-        cuts_.emplace_back();
-        (side == 0 ? cuts_[std::size_t(node.tree)].below : cuts_[std::size_t(node.tree)].above) = tree;
-        const auto [lo, hi] = halves[side];
-        const Box& box = side == 0 ? lower : upper;
-        if (hi - lo == 1) {
-          cuts_[std::size_t(tree)].rank = lo;
-          boxes_[std::size_t(lo)] = box;
-        } else {
-          child[2 * n + std::size_t(side)] = int(next.size());
-          next.push_back({lo, hi, tree, box});
-        }
-      }
-    }
-    for (std::size_t k = 0; k < local.size(); ++k)
-      if (const int n = node_of[k]; n >= 0)
-        node_of[k] = child[2 * std::size_t(n) + (local[k].x[axis[std::size_t(n)]] < high[std::size_t(n)] ? 0 : 1)];
-    level.swap(next);
-  }
-}
-
 void MpiExchange::redistribute(const Model& model, State& s) {
   migrate(s);
   send_ghosts(model, s);
@@ -281,7 +163,7 @@ void MpiExchange::migrate(State& s) {
   // Also whenever the grains come without a list (shared anew, resumed, a round inserted): the
   // cuts then follow from the grains alone, not from what the exchange did before.
   const bool recut = cuts_.empty() || !listed || heaviest > 1.2 * mean;
-  if (recut) partition(points);
+  if (recut) cuts_.cut(points);
 
   std::vector<std::vector<char>> out(static_cast<std::size_t>(ranks_));
   std::vector<std::size_t> keep;
@@ -307,7 +189,7 @@ void MpiExchange::migrate(State& s) {
   };
   // A unit's destination; a lost grain stays where it was lost: it takes part in nothing.
   const auto destination = [&](bool active, const Vec3& x) {
-    const int to = active ? owner(x) : rank_;
+    const int to = active ? cuts_.owner(x) : rank_;
     if (to != rank_ && !std::binary_search(neighbours_.begin(), neighbours_.end(), to)) beyond_neighbours = true;
     return to;
   };
@@ -382,14 +264,15 @@ void MpiExchange::send_ghosts(const Model& model, State& s) {
   // The owned grains lie in this rank's box, or as far outside it as a member from its centre:
   // only boxes within reach of that can want them.
   neighbours_.clear();
+  const std::vector<Box>& boxes = cuts_.boxes();
   for (int r = 0; r < ranks_; ++r)
-    if (r != rank_ && boxes_[std::size_t(r)].distance(boxes_[std::size_t(rank_)]) < reach + outside) neighbours_.push_back(r);
+    if (r != rank_ && boxes[std::size_t(r)].distance(boxes[std::size_t(rank_)]) < reach + outside) neighbours_.push_back(r);
   send_.assign(std::size_t(ranks_), {});
   std::vector<std::vector<char>> out(static_cast<std::size_t>(ranks_));
   for (std::size_t i = 0; i < s.size(); ++i) {
     if (!s.active[i]) continue;
     for (int r : neighbours_)
-      if (boxes_[std::size_t(r)].distance(s.x[i]) < reach) {
+      if (boxes[std::size_t(r)].distance(s.x[i]) < reach) {
         send_[std::size_t(r)].push_back(std::int32_t(i));
         put(out[std::size_t(r)], grain_record(s, i));
       }

@@ -196,7 +196,7 @@ PreparedDie prepare_die(const DieFile& file, const DieOptions& options, const st
           return out;
         }
       } catch (const std::exception& e) {
-        diefill::log::warn("ignoring a broken cache entry {}: {}", base.string(), e.what());
+        diefill::log::warn_here("ignoring a broken cache entry {}: {}", base.string(), e.what());
       }
     }
   }

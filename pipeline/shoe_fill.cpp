@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <numbers>
+#include <stdexcept>
 
 #include "core/log.hpp"
 #include "core/sha256.hpp"
@@ -147,6 +148,15 @@ void rest(dem::State& state) {
   state.step = 0;
 }
 
+// Every rank builds the clump template itself (from the same mesh and seed) and keeps its share
+// of clumps drawn from it: should the builds ever differ, the shares would not fit together.
+void expect_same_template_on_every_rank(const mesh::ClumpTemplate& clump, dem::Exchange& ranks) {
+  double fingerprint = clump.mesh_volume_m3;
+  for (const mesh::ClumpSphere& sphere : clump.spheres) fingerprint += sphere.radius + sphere.centre.sum() * 0.5;
+  if (ranks.max(fingerprint) != -ranks.max(-fingerprint))
+    throw std::logic_error("the ranks built different clump templates from one grain mesh");
+}
+
 }  // namespace
 
 std::string settled_shoe_key(const PipelineScene& s, const SettledShoeInputs& in, std::string_view dem_source_hash) {
@@ -162,6 +172,7 @@ std::optional<SettledShoe> fill_and_settle_shoe(const PipelineScene& s, const Fi
   // Clumps are settled afresh each run: the particles file does not hold their poses.
   if (!s.shape_mesh.empty()) {
     in.clump = build_clump({s.shape_mesh, mesh::parse_unit(s.shape_units, "powder.shape.units"), s.shape_tolerance, 64, s.seed});
+    if (ranks) expect_same_template_on_every_rank(*in.clump, *ranks);
     std::optional<SettledShoe> settled = settle_afresh(in, walls.die.name);
     if (settled) rest(settled->state);
     return settled;

@@ -26,6 +26,7 @@ packages=(
   python3-vtk9 python3-meshio                     # OpenVDB, VTK and meshio, not our code
   python3-matplotlib                        # the pictures of reports and studies
   libopenmpi-dev openmpi-bin                # the DEM split over MPI ranks (dem/mpi_exchange.hpp)
+  libtrilinos-zoltan-dev                    # the partitioner benchmark's reference (bench/partition.cpp)
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -187,6 +187,21 @@ TEST(Reproducibility, ResumedRunMatchesTheUninterruptedOne) {
   EXPECT_THROW(dem::read_checkpoint(dem::compile_model(other, b, "gas"), dir / "run.ckpt"), diefill::InputError);
 }
 
+// A checkpoint of an older format (the split one before clumps were split, DFCKSP01) is refused
+// with what happened and what to do, not as "not a checkpoint".
+TEST(Reproducibility, ACheckpointOfAnotherVersionIsRefusedAsSuch) {
+  test::TempDir dir;
+  dem::State s = gas(10, 2, 0.3);
+  const dem::Model model = dem::compile_model(gas_spec(true), s, "gas");
+  test::write_text(dir / "old.ckpt", "DFCKSP01" + model.hash + std::string(64, '\0'));
+  try {
+    dem::read_checkpoint(model, dir / "old.ckpt");
+    ADD_FAILURE() << "the old checkpoint was read";
+  } catch (const diefill::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("another version of diefill"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Insertion, FillsAClosedMeshWithoutOverlapsReproducibly) {
   const mesh::TriMesh ring = mesh::bundled_die("ring");
   mesh::SdfOptions o;
