@@ -16,12 +16,16 @@ int run_sdf(const SdfCommand& c) {
       c.voxel_mm ? std::optional<double>(*c.voxel_mm * mm) : std::nullopt);
   options.unit = mesh::parse_unit(c.units, "--units");
   options.role = mesh::parse_role(c.role, "--role");
+  options.up = mesh::parse_up(c.up, "--up");
   if (c.tolerance_mm) options.repair.tolerance_m = *c.tolerance_mm * mm;
   if (c.max_hole_mm) options.repair.max_hole_m = *c.max_hole_mm * mm;
   options.table_margin_m = c.table_margin_mm * mm;
 
   const mesh::PreparedDie die = mesh::prepare_die(c.mesh, options, std::nullopt);
   fmt::print("mesh {} ({} units: {})\n", die.source, mesh::unit_name(options.unit), die.sha256);
+  if (die.up != mesh::Up{})
+    fmt::print("orientation: the opening faces {} in the file ({}); turned so that it faces +z\n", mesh::up_name(die.up),
+               die.up_found ? "found: its largest flat face at an extreme; --up chooses" : "--up");
   fmt::print("check:\n{}", mesh::format_report(die.before));
   if (die.actions.empty()) {
     fmt::print("repair: nothing to do\n");

@@ -16,6 +16,7 @@ struct SdfCommand {
   std::filesystem::path output;
   std::string units = "mm";
   std::string role = "cavity";
+  std::string up = "auto";  // the way a cavity's opening faces in the file
   std::optional<double> voxel_mm;
   double grain_radius_mm = 0.5;
   double skin_mm = 0.25;
@@ -33,6 +34,7 @@ struct RunCommand {
   std::vector<std::string> overrides;
   std::optional<int> threads;
   std::optional<std::uint64_t> seed;
+  std::optional<std::string> up;  // die.up
   bool resume = false;
 };
 int run_pipeline(const RunCommand& command);

@@ -16,6 +16,8 @@ void add_sdf(CLI::App& root, app::SdfCommand& c, std::function<int()>& action) {
   cmd->add_option("-o,--output", c.output, "Output .vdb file");
   cmd->add_option("--voxel", c.voxel_mm, "Voxel edge [mm] (default: a quarter of the grain radius)");
   cmd->add_option("--units", c.units, "Length unit of the file: mm, m or in")->capture_default_str();
+  cmd->add_option("--up", c.up, "The way a cavity's opening faces in the file: +x, -x, +y, -y, +z, -z, or auto (found)")
+      ->capture_default_str();
   cmd->add_option("--role", c.role, "cavity (the part, open at the table), tool (the die body) or container (a closed vessel)")
       ->capture_default_str();
   cmd->add_option("--grain-radius", c.grain_radius_mm, "Largest grain radius [mm]")->capture_default_str();
@@ -35,6 +37,7 @@ void add_run(CLI::App& root, app::RunCommand& c, std::function<int()>& action) {
   cmd->add_option("--set", c.overrides, "Override a scene key: --set motion.speed=0.2");
   cmd->add_option("--threads", c.threads, "Threads (default: all cores); results do not depend on it");
   cmd->add_option("--seed", c.seed, "Random seed of the powder");
+  cmd->add_option("--up", c.up, "The way the die's opening faces in its file: +x, -x, +y, -y, +z, -z or auto (die.up)");
   cmd->add_flag("--resume", c.resume, "Continue an interrupted run from its checkpoint");
   cmd->callback([&] { action = [&] { return app::run_pipeline(c); }; });
 }
@@ -89,8 +92,8 @@ void add_density(CLI::App& root, app::DensityCommand& c, std::function<int()>& a
 }
 
 void add_die(CLI::App& root, app::DieCommand& c, std::function<int()>& action) {
-  CLI::App* cmd = root.add_subcommand("die", "Write a bundled die mesh (ring, disc, gear, slot) as binary STL in mm");
-  cmd->add_option("NAME", c.name, "ring, disc, gear (24 teeth, module 1.2 mm) or slot (1.2 mm wide)")->required();
+  CLI::App* cmd = root.add_subcommand("die", "Write a bundled die mesh (ring, disc, gear, slot, spline) as binary STL in mm");
+  cmd->add_option("NAME", c.name, "ring, disc, gear (24 teeth, module 1.2 mm), slot (1.2 mm wide) or spline (a splined bore, ISO 14 6 x 11 x 14)")->required();
   cmd->add_option("-o,--output", c.output, "Output STL")->required();
   cmd->callback([&] { action = [&] { return app::run_die(c); }; });
 }

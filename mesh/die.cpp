@@ -134,11 +134,11 @@ DieOptions die_options_for_grains(double grain_radius_m, double skin_m, std::opt
   return o;
 }
 
-std::string die_cache_key(const std::string& file_sha256, const DieOptions& o) {
+std::string die_cache_key(const std::string& file_sha256, Up up, const DieOptions& o) {
   std::string text = fmt::format(
-      "format={};sha={};unit={};role={};voxel={:.17g};ext={:.17g};int={:.17g};tol={:.17g};"
+      "format={};sha={};unit={};up={};role={};voxel={:.17g};ext={:.17g};int={:.17g};tol={:.17g};"
       "hole={:.17g};wrap={};margin={:.17g}",
-      cache_format, file_sha256, unit_name(o.unit), role_name(o.role), o.voxel_m, o.exterior_band_m,
+      cache_format, file_sha256, unit_name(o.unit), up_name(up), role_name(o.role), o.voxel_m, o.exterior_band_m,
       o.interior_band_m, o.repair.tolerance_m, o.repair.max_hole_m, o.repair.allow_wrap,
       o.table_margin_m);
   if (o.table)
@@ -147,7 +147,7 @@ std::string die_cache_key(const std::string& file_sha256, const DieOptions& o) {
   return diefill::sha256_hex(text);
 }
 
-DieFile read_die_file(const fs::path& path, LengthUnit unit) {
+DieFile read_die_file(const fs::path& path, LengthUnit unit, std::optional<Up> up) {
   DieFile file;
   file.source = path.string();
   file.name = path.stem().string();
@@ -155,11 +155,15 @@ DieFile read_die_file(const fs::path& path, LengthUnit unit) {
   // Import first: it gives the clear message for a missing, empty or unreadable file.
   file.mesh = import_mesh(path, {unit}).mesh;
   file.sha256 = diefill::sha256_file(path);
+  file.up_found = !up;
+  file.up = up ? *up : find_opening(file.mesh, file.source);
+  turn_up(file.mesh, file.up);
   return file;
 }
 
 PreparedDie prepare_die(const fs::path& path, const DieOptions& options, const std::optional<fs::path>& cache_dir) {
-  return prepare_die(read_die_file(path, options.unit), options, cache_dir);
+  const std::optional<Up> up = options.up || options.role == WallRole::cavity ? options.up : Up{};
+  return prepare_die(read_die_file(path, options.unit, up), options, cache_dir);
 }
 
 PreparedDie prepare_die(const DieFile& file, const DieOptions& options, const std::optional<fs::path>& cache_dir) {
@@ -167,11 +171,15 @@ PreparedDie prepare_die(const DieFile& file, const DieOptions& options, const st
   check_options(options, source);
   if (file.unit != options.unit)
     throw InputError(source, "units", "the file was read in another unit than the options give", "Read it in the options' unit");
+  if (options.up && *options.up != file.up)
+    throw InputError(source, "up", "the file was turned another way than the options give", "Read it with the options' up");
   PreparedDie out;
   out.source = source;
   out.name = file.name;
   out.sha256 = file.sha256;
-  out.cache_key = die_cache_key(out.sha256, options);
+  out.up = file.up;
+  out.up_found = file.up_found;
+  out.cache_key = die_cache_key(out.sha256, file.up, options);
 
   if (cache_dir) {
     const fs::path base = *cache_dir / out.cache_key;

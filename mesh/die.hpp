@@ -7,6 +7,7 @@
 #include <string>
 
 #include "mesh/import.hpp"
+#include "mesh/orientation.hpp"
 #include "mesh/repair.hpp"
 #include "mesh/sdf.hpp"
 #include "mesh/tool.hpp"
@@ -29,6 +30,8 @@ inline constexpr double default_voxel_fraction = 0.25;
 struct DieOptions {
   LengthUnit unit = LengthUnit::mm;
   WallRole role = WallRole::cavity;
+  // The way the opening faces in the file; unset: found (find_opening) for a cavity, +z otherwise.
+  std::optional<Up> up;
   double voxel_m = 1.25e-4;         // voxel edge [m]
   double exterior_band_m = 1e-3;    // contact range plus neighbour skin plus one voxel [m]
   double interior_band_m = 2.5e-4;  // [m]
@@ -41,6 +44,8 @@ struct PreparedDie {
   std::string name;    // file stem
   std::string source;  // path as given
   std::string sha256;  // of the file's bytes
+  Up up;               // the way its opening faced in the file (now +z)
+  bool up_found = false;  // found by looking, not given
   MeshReport before, after;          // checks before and after repair
   std::vector<std::string> actions;  // repair steps taken
   bool wrapped = false;
@@ -61,10 +66,13 @@ struct DieFile {
   std::string source;  // path as given
   std::string sha256;  // of the file's bytes
   LengthUnit unit = LengthUnit::mm;
+  Up up;                  // the way its opening faced in the file; the mesh is turned to face +z
+  bool up_found = false;  // found by looking, not given
   TriMesh mesh;        // [m]
 };
-// Throws InputError for a missing, empty or unreadable file.
-DieFile read_die_file(const std::filesystem::path& path, LengthUnit unit);
+// Reads the file and turns it so that its opening faces +z (`up` unset: find_opening). Throws
+// InputError for a missing, empty or unreadable file.
+DieFile read_die_file(const std::filesystem::path& path, LengthUnit unit, std::optional<Up> up = Up{});
 
 // Throws InputError for every defect of the file or the options (a die smaller than a few
 // voxels, for instance, usually a mesh in metres read as millimetres).
@@ -79,6 +87,6 @@ DieOptions die_options_for_grains(double grain_radius_m, double skin_m,
                                   std::optional<double> voxel_m = std::nullopt);
 
 // The cache key: the file's bytes and every parameter that changes the result.
-std::string die_cache_key(const std::string& file_sha256, const DieOptions& options);
+std::string die_cache_key(const std::string& file_sha256, Up up, const DieOptions& options);
 
 }  // namespace mesh

@@ -25,7 +25,8 @@ TriMesh shoe_solid(double inner_length, double inner_width, double height, doubl
 // dies/ (bundled_die_names). "gear" and "slot" have sharp features between close cavity features,
 // made as a CAD tool extrudes a profile (fans of sliver triangles from the axis, full-height side
 // quads): a spur gear of 24 involute teeth, module 1.2 mm, 8 mm deep; a slot 1.2 mm wide, 10 mm
-// long, 8 mm deep.
+// long, 8 mm deep; "spline", a hub Ø24 mm around a splined core rod (the part's splined bore,
+// ISO 14 straight-sided 6 x 11 x 14, keys 3 mm wide), 8 mm deep.
 TriMesh bundled_die(const std::string& name);
 std::vector<std::string> bundled_die_names();
 std::vector<std::string> generated_die_names();  // every name bundled_die takes

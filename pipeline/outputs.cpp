@@ -42,6 +42,8 @@ nlohmann::json report_json(const FillRecord& r, const nlohmann::json& fill) {
        {{"name", die.name},
         {"source", die.source},
         {"sha256", die.sha256},
+        {"up_in_file", mesh::up_name(die.up)},
+        {"up_found", die.up_found},
         {"cavity_volume_m3", die.after.volume_m3},
         {"triangles", die.before.triangles},
         {"repaired", !die.actions.empty()},

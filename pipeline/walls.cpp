@@ -22,6 +22,7 @@ mesh::DieOptions die_options(const PipelineScene& s, const GrainSizing& grains, 
   const double r = grains.r_max;
   mesh::DieOptions o = mesh::die_options_for_grains(r, 0.5 * r, s.die_voxel_fraction * r);
   o.unit = source.file.unit;
+  o.up = source.file.up;
   o.role = mesh::WallRole::cavity;
   // Room beside the shoe: grains that pass under its walls (the strike-off) stay on the table
   // rather than falling off a table the size of the shoe (two radii let one grain in 2000 off).

@@ -54,6 +54,10 @@ KeyTable<P> make_pipeline_keys() {
       text("die", "file", KeyType::path, {}, die, "the die's cavity mesh (relative to the scene file)", &P::die),
       text("die", "units", KeyType::choice, {"mm", "m", "in"}, die, "the mesh file's length unit (files store none)",
            &P::die_units),
+      text("die", "up", KeyType::choice, {"auto", "+z", "-z", "+x", "-x", "+y", "-y"}, die,
+           "the way the cavity's opening faces in the file; the die is turned so that it faces up (+z). auto: +z "
+           "when a flat face lies at the top, else the axis with the largest flat face at its extreme",
+           &P::die_up),
       text("die", "role", KeyType::choice, {"cavity"}, die,
            "the mesh is the part's shape, open at the die table (its highest z); `diefill sdf --role` takes tools too",
            &P::die_role),

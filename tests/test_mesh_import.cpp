@@ -5,7 +5,9 @@
 #include <numbers>
 
 #include "core/error.hpp"
+#include "mesh/die.hpp"
 #include "mesh/import.hpp"
+#include "mesh/orientation.hpp"
 #include "mesh/shapes.hpp"
 #include "meshes.hpp"
 #include "support.hpp"
@@ -56,6 +58,86 @@ TEST(BundledDies, FilesInDiesAreTheGeneratedOnes) {
     EXPECT_EQ(test::read_text(regenerated), test::read_text(test::source_dir() / "dies" / (name + ".stl")))
         << "dies/" << name << ".stl differs from `diefill die " << name << "`";
   }
+}
+
+// The splined bore's hub: its volume is the outer circle's polygon less the core's, times the
+// depth (the mesh closes on its outlines), and the core's area is the ISO 14 profile's within the
+// chords cut every 3°: a 6 x 11 x 14 spline with 3 mm keys.
+TEST(BundledDies, SplinedBoreHasTheProfilesArea) {
+  const mesh::TriMesh die = mesh::bundled_die("spline");
+  const double depth = 8e-3, r = 5.5e-3, big_r = 7e-3, half = 1.5e-3;
+  // ∫ sqrt(a² - y²) dy over |y| < h.
+  const auto band = [](double a, double h) { return h * std::sqrt(a * a - h * h) + a * a * std::asin(h / a); };
+  const double core = std::numbers::pi * r * r + 6 * (band(big_r, half) - band(r, half));  // the minor circle and six keys
+  const double hub = std::numbers::pi * 12e-3 * 12e-3;
+  EXPECT_NEAR(mesh::signed_volume(die), (hub - core) * depth, 2e-3 * (hub - core) * depth);
+  const mesh::Box box = mesh::bounding_box(die);
+  EXPECT_DOUBLE_EQ(box.hi.z(), 0.0);
+  EXPECT_NEAR(box.size().x(), 24e-3, 2 * 5e-6);  // the outer circle's chord error, at most 5 µm each side
+}
+
+// The disc with a conical floor (its centre 1 mm lower): a cavity with one flat end only, its
+// opening, where an extruded part has two alike.
+mesh::TriMesh disc_with_one_flat_end() {
+  mesh::TriMesh die = mesh::bundled_die("disc");
+  for (Vec3& v : die.vertices)
+    if (v.head<2>().norm() < 1e-12 && v.z() < 0) v.z() -= 1e-3;
+  return die;
+}
+
+// A die lying on its side or upside down is found facing each of the six ways, and turned back
+// exactly (quarter and half turns only permute and negate coordinates); a proper rotation keeps
+// its volume's sign. An extruded part's two alike ends are told apart only by the flag: the
+// axis is found, the sign is +. A mesh with no flat face at any extreme is refused by name.
+TEST(Orientation, FindsTheOpeningWhicheverWayTheDieFaces) {
+  const mesh::TriMesh ring = disc_with_one_flat_end();
+  for (int axis = 0; axis < 3; ++axis)
+    for (int sign : {1, -1}) {
+      const mesh::Up up{axis, sign};
+      mesh::TriMesh lying = ring;
+      for (int k = 0; k < 3; ++k) mesh::turn_up(lying, up);  // a quarter or half turn's inverse
+      EXPECT_EQ(mesh::find_opening(lying, "ring"), up) << mesh::up_name(up);
+      EXPECT_NEAR(mesh::opening_area(lying, up), 0.25 * std::numbers::pi * 20e-3 * 20e-3, 1e-3 * 3.2e-4);
+      mesh::turn_up(lying, up);
+      EXPECT_EQ(lying.vertices, ring.vertices) << mesh::up_name(up);
+      EXPECT_DOUBLE_EQ(mesh::signed_volume(lying), mesh::signed_volume(ring));
+      mesh::TriMesh extruded = mesh::bundled_die("ring");
+      for (int k = 0; k < 3; ++k) mesh::turn_up(extruded, up);
+      EXPECT_EQ(mesh::find_opening(extruded, "ring"), (mesh::Up{axis, 1}));
+    }
+  mesh::TriMesh octahedron;
+  for (int a = 0; a < 3; ++a)
+    for (int s : {1, -1}) octahedron.vertices.push_back(s * Vec3::Unit(a) * 1e-2);
+  octahedron.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  try {
+    mesh::find_opening(octahedron, "octahedron.stl");
+    ADD_FAILURE() << "an octahedron has no opening";
+  } catch (const diefill::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no flat face"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(mesh::parse_up("auto", "die.up"), std::nullopt);
+  EXPECT_EQ(mesh::parse_up("-y", "die.up"), (mesh::Up{1, -1}));
+  EXPECT_THROW(mesh::parse_up("up", "die.up"), diefill::InputError);
+}
+
+// Read from a file with its opening facing -x, the die is the same cavity as the one facing up:
+// the same triangles in the same places, up to the file's single precision.
+TEST(Orientation, ADieFileOnItsSideIsReadFacingUp) {
+  test::TempDir dir;
+  const mesh::TriMesh ring = disc_with_one_flat_end();
+  mesh::TriMesh lying = ring;
+  for (int k = 0; k < 3; ++k) mesh::turn_up(lying, mesh::Up{0, -1});
+  mesh::write_stl(lying, dir / "lying.stl", mesh::LengthUnit::mm, "ring on its side");
+  mesh::write_stl(ring, dir / "upright.stl", mesh::LengthUnit::mm, "ring");
+  const mesh::DieFile found = mesh::read_die_file(dir / "lying.stl", mesh::LengthUnit::mm, std::nullopt);
+  const mesh::DieFile upright = mesh::read_die_file(dir / "upright.stl", mesh::LengthUnit::mm, std::nullopt);
+  EXPECT_TRUE(found.up_found);
+  EXPECT_EQ(found.up, (mesh::Up{0, -1}));
+  EXPECT_EQ(upright.up, mesh::Up{});
+  ASSERT_EQ(found.mesh.triangles.size(), upright.mesh.triangles.size());
+  EXPECT_NEAR(mesh::signed_volume(found.mesh), mesh::signed_volume(upright.mesh), 1e-6 * mesh::signed_volume(upright.mesh));
+  const mesh::Box a = mesh::bounding_box(found.mesh), b = mesh::bounding_box(upright.mesh);
+  EXPECT_LT((a.lo - b.lo).norm() + (a.hi - b.hi).norm(), 1e-8);
 }
 
 TEST(Import, ReadsFormatsAndWeldsToTheSameSolid) {

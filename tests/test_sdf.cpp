@@ -60,8 +60,8 @@ INSTANTIATE_TEST_SUITE_P(Dies, SdfOnBundledDie, ::testing::Values("ring", "disc"
 
 // Random samples rarely land where a wrong sign would do harm: beside the sharp edges and corners
 // of close cavity features, where the closest feature is an edge or a vertex shared by sliver
-// triangles. So the points here sit within 0.8 mm of every vertex of the gear's and the slot's
-// extruded outlines (at the floor, at mid-depth and at the table), as grains of 0.4 mm radius
+// triangles. So the points here sit within 0.8 mm of every vertex of the gear's, the slot's and
+// the splined bore's extruded outlines (at the floor, at mid-depth and at the table), as grains of 0.4 mm radius
 // touching the walls would; for each farther than half a voxel from the surface, the field's
 // sign and every wall contact's sign must be the exact (Embree) one.
 class SignAtSharpFeatures : public ::testing::TestWithParam<std::string> {};
@@ -106,7 +106,7 @@ TEST_P(SignAtSharpFeatures, IsTheExactSignBesideEveryEdgeAndCorner) {
               field_wrong, contact_wrong);
 }
 
-INSTANTIATE_TEST_SUITE_P(Dies, SignAtSharpFeatures, ::testing::Values("gear", "slot"));
+INSTANTIATE_TEST_SUITE_P(Dies, SignAtSharpFeatures, ::testing::Values("gear", "slot", "spline"));
 
 TEST(Sdf, BandCoversContactRangeAndSkinOnly) {
   const mesh::DieOptions o = default_options();
