@@ -54,23 +54,22 @@ int run_simulate(const SimulateCommand& c) {
     dem::agree_on_failure(*ranks, failure);
   }
   int snapshot = 0;
-  double next_snapshot = scene.output.snapshot_every > 0 ? state.time : std::numeric_limits<double>::infinity();
   LoopOptions loop;
   loop.until = scene.duration;
   loop.checkpoint = checkpoint;
-  loop.output_every = scene.output.trajectory ? scene.output.trajectory_every
-                                              : (scene.output.snapshot_every > 0 ? scene.output.snapshot_every : 0);
-  if (scene.output.trajectory && scene.output.snapshot_every > 0)
-    loop.output_every = std::min(scene.output.trajectory_every, scene.output.snapshot_every);
-  loop.output = [&](const dem::State& s) {
-    const bool snapshot_due = s.time >= next_snapshot - 0.5 * model.dt;
-    if (snapshot_due) next_snapshot += scene.output.snapshot_every;
-    if (!scene.output.trajectory && !snapshot_due) return;
-    dem::with_whole_state(s, [&](const dem::State& whole) {
-      if (trajectory) trajectory->write(whole);
-      if (snapshot_due) dem::write_vtu(whole, dir / fmt::format("snapshot_{:05d}.vtu", snapshot++));
-    });
-  };
+  // Every rank gathers (collective); rank 0 alone holds the trajectory's file.
+  if (scene.output.trajectory)
+    loop.outputs.push_back({scene.output.trajectory_every, [&](const dem::State& s) {
+                              dem::with_whole_state(s, [&](const dem::State& whole) {
+                                if (trajectory) trajectory->write(whole);
+                              });
+                            }});
+  if (scene.output.snapshot_every > 0)
+    loop.outputs.push_back({scene.output.snapshot_every, [&](const dem::State& s) {
+                              dem::with_whole_state(s, [&](const dem::State& whole) {
+                                dem::write_vtu(whole, dir / fmt::format("snapshot_{:05d}.vtu", snapshot++));
+                              });
+                            }});
   install_interrupt_handler();
   const LoopResult result = run_until(model, state, loop);
   const std::int64_t lost = ranks ? ranks->sum(state.lost) : state.lost;

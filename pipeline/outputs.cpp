@@ -8,6 +8,8 @@
 #include "dem/io.hpp"
 #include "dem/step.hpp"
 #include "pipeline/density_stage.hpp"
+#include "pipeline/fill_curve.hpp"
+#include "pipeline/pictures.hpp"
 
 namespace app {
 
@@ -30,6 +32,19 @@ nlohmann::json write_density_field(const FillRecord& r, const fs::path& dir) {
   field.field.metadata["die"] = r.walls.die.name;
   write_density(field, dir);
   return statistics_json(field.stats);
+}
+
+// The fill curve (CSV and chart; it ends at the field's mass, fill.mass_kg) and what the report
+// says of it: the cavity's capacity (its volume full of solid material) and the strike-off.
+nlohmann::json write_fill_curve_outputs(const FillRecord& r, const fs::path& dir) {
+  const double density = r.walls.spec.materials[std::size_t(r.walls.powder)].density;
+  const double capacity = r.walls.die.after.volume_m3 * density;
+  const double strike_off = strike_off_time(r.shoe, mesh::bounding_box(r.walls.die.cavity).hi.x());
+  write_fill_curve(r.fill.curve, capacity, dir / "fill_curve.csv");
+  draw_pictures({"fill_curve", (dir / "fill_curve.csv").string(), fmt::format("{:.9g}", strike_off)});
+  return {{"cavity_capacity_kg", capacity},
+          {"strike_off_s", strike_off},
+          {"curve", "fill_curve.csv"}};
 }
 
 nlohmann::json report_json(const FillRecord& r, const nlohmann::json& fill) {
@@ -86,7 +101,8 @@ nlohmann::json report_json(const FillRecord& r, const nlohmann::json& fill) {
 
 nlohmann::json write_fill_outputs(const FillRecord& r, const fs::path& dir) {
   diefill::StagingFolder out(dir);
-  const nlohmann::json fill = write_density_field(r, out.path());
+  nlohmann::json fill = write_density_field(r, out.path());
+  fill.update(write_fill_curve_outputs(r, out.path()));
   dem::write_particles_csv(r.fill.state, out / "particles.csv");
   dem::write_vtu(r.fill.state, out / "final.vtu");
   diefill::write_file_atomic(out / "scene.toml", describe(r.scene));

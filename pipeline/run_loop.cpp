@@ -41,16 +41,19 @@ LoopResult run_until(const dem::Model& model, dem::State& s, const LoopOptions& 
   diefill::Stopwatch clock;
   diefill::Progress progress(o.label, o.until);
   const double start = s.time;
-  double next_output = o.output_every > 0 ? s.time : std::numeric_limits<double>::infinity();
+  std::vector<double> next_output(o.outputs.size(), s.time);
   const std::int64_t grains = s.exchange ? s.exchange->sum(std::int64_t(s.owned())) : std::int64_t(s.size());
   while (s.time < o.until - 0.5 * model.dt) {
-    if (s.time >= next_output - 0.5 * model.dt && o.output) {
-      o.output(s);
-      next_output += o.output_every;
-      if (o.finished && o.finished(s)) {
-        result.finished_early = true;
-        break;
+    bool output = false;
+    for (std::size_t k = 0; k < o.outputs.size(); ++k)
+      if (s.time >= next_output[k] - 0.5 * model.dt) {
+        o.outputs[k].action(s);
+        next_output[k] += o.outputs[k].every;
+        output = true;
       }
+    if (output && o.finished && o.finished(s)) {
+      result.finished_early = true;
+      break;
     }
     const dem::StepReport report = dem::step(model, s, &result.times);
     ++result.steps;
@@ -72,7 +75,8 @@ LoopResult run_until(const dem::Model& model, dem::State& s, const LoopOptions& 
                                                   o.detail ? ", " + o.detail(s) : std::string()));
     }
   }
-  if (o.output && !result.interrupted && !result.finished_early) o.output(s);
+  if (!result.interrupted && !result.finished_early)
+    for (const Periodic& p : o.outputs) p.action(s);
   result.wall_s = clock.seconds();
   progress.finish(fmt::format("{} steps, {:.3g} particle-steps/s", result.steps,
                               double(result.steps) * double(grains) / std::max(1e-9, result.wall_s)));

@@ -6,6 +6,7 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "dem/model.hpp"
 #include "dem/state.hpp"
@@ -13,13 +14,18 @@
 
 namespace app {
 
+// An output at its own cadence: at the start, every `every` seconds of simulated time, and at the end.
+struct Periodic {
+  double every = 0;  // [s]
+  std::function<void(const dem::State&)> action;
+};
+
 struct LoopOptions {
   double until = 0;  // simulated time to reach [s]
   std::string label = "simulating";
   std::filesystem::path checkpoint;  // written on a stop (stability or Ctrl-C)
-  double output_every = 0;           // [s]; 0: never
-  std::function<void(const dem::State&)> output;
-  // Asked after each output: true ends the loop there (a drained container).
+  std::vector<Periodic> outputs;     // called in this order when several fall due together
+  // Asked after the outputs of a step: true ends the loop there (a drained container).
   std::function<bool(const dem::State&)> finished;
   // Extra words for the progress line (grains in the cavity, ...).
   std::function<std::string(const dem::State&)> detail;

@@ -16,7 +16,7 @@ std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& wal
                                     dem::State settled, const fs::path& dir, bool resume) {
   dem::ModelSpec spec = walls.spec;
   spec.meshes[1].motion = shoe.motion;
-  FillResult fill{std::move(settled), {}, 0};
+  FillResult fill{std::move(settled), {}, 0, {}};
   dem::State& state = fill.state;
   const dem::Model model = dem::compile_model(spec, state, s.source);
   fill.dt = model.dt;
@@ -35,13 +35,13 @@ std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& wal
   loop.label = walls.die.name + ": filling";
   loop.checkpoint = checkpoint;
   int snapshot = 0;
-  if (s.snapshot_every > 0) {
-    loop.output_every = s.snapshot_every;
-    loop.output = [&](const dem::State& st) {
-      const fs::path file = dir / fmt::format("snapshot_{:05d}.vtu", snapshot++);
-      dem::with_whole_state(st, [&](const dem::State& whole) { dem::write_vtu(whole, file); });
-    };
-  }
+  if (s.snapshot_every > 0)
+    loop.outputs.push_back({s.snapshot_every, [&](const dem::State& st) {
+                              const fs::path file = dir / fmt::format("snapshot_{:05d}.vtu", snapshot++);
+                              dem::with_whole_state(st, [&](const dem::State& whole) { dem::write_vtu(whole, file); });
+                            }});
+  const double density = walls.spec.materials[std::size_t(walls.powder)].density;
+  loop.outputs.push_back({s.fill_curve_every, [&](const dem::State& st) { fill.curve.push_back(sample_fill(st, table_z, density, shoe)); }});
   loop.detail = [&](const dem::State& st) {
     std::size_t n = 0;
     for (std::size_t i = 0; i < st.owned(); ++i) n += st.active[i] && st.body[i] < 0 && st.x[i].z() < table_z;

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "dem/state.hpp"
+#include "pipeline/fill_curve.hpp"
 #include "pipeline/run_loop.hpp"
 #include "pipeline/walls.hpp"
 
@@ -14,6 +15,7 @@ struct FillResult {
   dem::State state;  // split over ranks: the whole state on rank 0, none elsewhere
   LoopResult loop;
   double dt = 0;  // [s]
+  std::vector<FillSample> curve;  // from the start of this run of the loop (a resumed run: from its resumption)
 };
 
 // nullopt when Ctrl-C stopped it (a checkpoint is in `dir`); StabilityError when a check did.

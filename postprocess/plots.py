@@ -6,6 +6,8 @@
     plots.py clump NAME_errors.csv  ->  NAME_errors.png: a clump's errors and cost against its
                                         sphere count
     plots.py study DIR/NAME.json  ->  every chart the study lists under "charts", into DIR
+    plots.py fill_curve DIR/fill_curve.csv STRIKE_OFF_S  ->  DIR/fill_curve.png: the mass in the
+                                  cavity against time and against the shoe's position
 
 Each picture has axes with units and, where colour carries a value, a colour bar.
 """
@@ -137,5 +139,35 @@ def study(document: Path) -> None:
         plt.close(fig)
 
 
+def fill_curve(csv: Path, strike_off_s: float) -> None:
+    rows = np.genfromtxt(csv, delimiter=",", names=True)
+    t, x, fraction = np.atleast_1d(rows["t_s"]), np.atleast_1d(rows["shoe_x_m"]) * 1e3, np.atleast_1d(rows["fraction_of_capacity"])
+    mass_g = np.atleast_1d(rows["mass_in_cavity_kg"]) * 1e3
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4))
+    left.plot(t, mass_g, color="tab:blue")
+    left.axvline(strike_off_s, color="k", linestyle="--", label=f"strike-off, t = {strike_off_s:.3f} s")
+    left.set_xlabel("time [s]")
+    left.set_ylabel("mass in the cavity [g]")
+    if fraction.max() > 0:  # the same curve on the capacity's scale
+        capacity_g = mass_g.max() / fraction.max()
+        twin = left.twinx()
+        twin.set_ylim(*(np.array(left.get_ylim()) / capacity_g))
+        twin.set_ylabel("fraction of the cavity's capacity [-]")
+    left.legend(loc="lower right")
+    left.grid(alpha=0.3)
+    moving = np.concatenate([[True], np.diff(x) != 0])
+    right.plot(x[moving], mass_g[moving], color="tab:orange")
+    right.set_xlabel("shoe centre x [mm] (shoe travel, +x)")
+    right.set_ylabel("mass in the cavity [g]")
+    right.grid(alpha=0.3)
+    fig.suptitle("Fill curve: powder delivered into the die")
+    fig.tight_layout()
+    fig.savefig(csv.with_suffix(".png"), dpi=120)
+    plt.close(fig)
+
+
 if __name__ == "__main__":
-    {"density": density, "clump": clump, "study": study}[sys.argv[1]](Path(sys.argv[2]))
+    if sys.argv[1] == "fill_curve":
+        fill_curve(Path(sys.argv[2]), float(sys.argv[3]))
+    else:
+        {"density": density, "clump": clump, "study": study}[sys.argv[1]](Path(sys.argv[2]))

@@ -120,6 +120,9 @@ KeyTable<P> make_pipeline_keys() {
                    "to the working folder)", &P::out));
   k.push_back(number("output", "snapshot_every", "s", {0, 100}, nothing, "VTU snapshots; 0: the final state only",
                      &P::snapshot_every));
+  k.push_back(number("output", "fill_curve_every", "s", {0, 1, true}, nothing,
+                     "the fill curve's sampling (fill_curve.csv: mass in the cavity against time and the shoe's position)",
+                     &P::fill_curve_every));
   return k;
 }
 

@@ -52,6 +52,7 @@ struct PipelineScene {
   // [output]
   std::filesystem::path out = "out";
   double snapshot_every = 0;          // [s]; 0: final snapshot only
+  double fill_curve_every = 0.002;    // [s]
 
   PipelineScene();  // the defaults: materials "powder" and "steel", EPSD rolling, ...
   double grain_diameter() const { return coarse_graining * particle_diameter; }

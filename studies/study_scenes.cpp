@@ -122,13 +122,12 @@ SlotRun run_slot_container(const Powder& p, const SlotContainer& c, const std::s
   const auto gone = [&](std::size_t i) { return !run.state.active[i] || run.state.x[i].z() < -floor; };
   double quiet_since = opened;
   LoopOptions sampling;
-  sampling.output_every = c.sample_every;
-  sampling.output = [&](const dem::State& s) {
-    const double m = mass_where(s, gone);
-    if (run.discharged.empty() || m > run.discharged.back()) quiet_since = s.time;
-    run.time.push_back(s.time - opened);
-    run.discharged.push_back(m);
-  };
+  sampling.outputs.push_back({c.sample_every, [&](const dem::State& s) {
+                                const double m = mass_where(s, gone);
+                                if (run.discharged.empty() || m > run.discharged.back()) quiet_since = s.time;
+                                run.time.push_back(s.time - opened);
+                                run.discharged.push_back(m);
+                              }});
   if (c.stop_when_drained) sampling.finished = [&](const dem::State& s) { return s.time - quiet_since > 0.1; };
   advance(open, run.state, opened + c.flow_time, label, sampling);
   return run;

@@ -1,0 +1,73 @@
+#include "pipeline/fill_curve.hpp"
+
+#include <fmt/core.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "core/atomic_file.hpp"
+
+namespace app {
+
+namespace {
+
+// The part of a sphere of radius r below a plane its centre lies h above (a cap, or all of it).
+double volume_below(double r, double h) {
+  if (h >= r) return 0;
+  if (h <= -r) return 4.0 / 3.0 * std::numbers::pi * r * r * r;
+  const double a = r - h;  // the cap's height
+  return std::numbers::pi * a * a * (3 * r - a) / 3;
+}
+
+}  // namespace
+
+FillSample sample_fill(const dem::State& s, double table_z, double material_density, const ShoePlan& shoe) {
+  FillSample out;
+  out.time = s.time;
+  out.shoe_x = shoe.motion.position(s.time).x();
+  double volume = 0;
+  for (std::size_t i = 0; i < s.owned(); ++i)
+    if (s.active[i] && s.body[i] < 0 && s.x[i].z() < table_z) {
+      ++out.grains;
+      volume += volume_below(s.radius[i], s.x[i].z() - table_z);
+    }
+  // A clump's members weighted so that they add up to the grain's volume (census.cpp).
+  const dem::Bodies& b = s.bodies;
+  for (std::size_t k = 0; k < b.size(); ++k) {
+    if (!b.active[k] || b.x[k].z() >= table_z) continue;
+    ++out.grains;
+    double members = 0, below = 0;
+    for (std::int32_t m = b.member_start[k]; m < b.member_start[k + 1]; ++m) {
+      const std::size_t i = std::size_t(b.member[std::size_t(m)]);
+      members += volume_below(s.radius[i], -s.radius[i]);
+      below += volume_below(s.radius[i], s.x[i].z() - table_z);
+    }
+    volume += b.volume[k] * below / members;
+  }
+  if (s.exchange) out.grains = s.exchange->sum(out.grains), volume = s.exchange->sum(volume);
+  out.mass = volume * material_density;
+  return out;
+}
+
+double strike_off_time(const ShoePlan& shoe, double die_far_x) {
+  // The first time past it, to a ten-thousandth of the motion, then bisected to the last bit.
+  const auto past = [&](double t) { return shoe.motion.position(t).x() - 0.5 * shoe.length >= die_far_x; };
+  constexpr int steps = 10000;
+  for (int k = 1; k <= steps; ++k) {
+    double hi = shoe.t_motion * k / steps;
+    if (!past(hi)) continue;
+    double lo = shoe.t_motion * (k - 1) / steps;
+    for (int n = 0; n < 60; ++n) (past(0.5 * (lo + hi)) ? hi : lo) = 0.5 * (lo + hi);
+    return hi;
+  }
+  return shoe.t_motion;
+}
+
+void write_fill_curve(const std::vector<FillSample>& curve, double capacity_kg, const std::filesystem::path& csv) {
+  std::string text = "t_s,shoe_x_m,grains_in_cavity,mass_in_cavity_kg,fraction_of_capacity\n";
+  for (const FillSample& p : curve)
+    text += fmt::format("{:.9g},{:.9g},{},{:.9g},{:.6g}\n", p.time, p.shoe_x, p.grains, p.mass, capacity_kg > 0 ? p.mass / capacity_kg : 0.0);
+  diefill::write_file_atomic(csv, text);
+}
+
+}  // namespace app
