@@ -33,6 +33,7 @@ void apply_command_line(PipelineScene& scene, const RunCommand& c) {
   if (c.threads) scene.threads = *c.threads;
   if (c.seed) scene.seed = *c.seed;
   if (c.up) scene.die_up = *c.up;
+  if (c.units) scene.die_units = *c.units;
 }
 
 // The mesh formats a CAD tool writes and assimp reads; anything else in the folder (a README, a

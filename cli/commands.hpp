@@ -34,7 +34,8 @@ struct RunCommand {
   std::vector<std::string> overrides;
   std::optional<int> threads;
   std::optional<std::uint64_t> seed;
-  std::optional<std::string> up;  // die.up
+  std::optional<std::string> up;     // die.up
+  std::optional<std::string> units;  // die.units
   bool resume = false;
 };
 int run_pipeline(const RunCommand& command);

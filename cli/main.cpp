@@ -38,6 +38,7 @@ void add_run(CLI::App& root, app::RunCommand& c, std::function<int()>& action) {
   cmd->add_option("--threads", c.threads, "Threads (default: all cores); results do not depend on it");
   cmd->add_option("--seed", c.seed, "Random seed of the powder");
   cmd->add_option("--up", c.up, "The way the die's opening faces in its file: +x, -x, +y, -y, +z, -z or auto (die.up)");
+  cmd->add_option("--units", c.units, "Length unit of the die's file: mm, m or in (die.units)");
   cmd->add_flag("--resume", c.resume, "Continue an interrupted run from its checkpoint");
   cmd->callback([&] { action = [&] { return app::run_pipeline(c); }; });
 }

@@ -174,6 +174,21 @@ void write_stl(const TriMesh& mesh, const fs::path& path, LengthUnit unit,
   diefill::write_file_atomic(path, bytes);
 }
 
+void write_vtp(const TriMesh& mesh, const fs::path& path, const Vec3& shift) {
+  std::string out = fmt::format(
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<PolyData>\n"
+      "<Piece NumberOfPoints=\"{}\" NumberOfPolys=\"{}\">\n<Points>\n"
+      "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n",
+      mesh.vertices.size(), mesh.triangles.size());
+  for (const Vec3& v : mesh.vertices) out += fmt::format("{:.9g} {:.9g} {:.9g}\n", v.x() + shift.x(), v.y() + shift.y(), v.z() + shift.z());
+  out += "</DataArray>\n</Points>\n<Polys>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+  for (const Triangle& t : mesh.triangles) out += fmt::format("{} {} {}\n", t[0], t[1], t[2]);
+  out += "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+  for (std::size_t k = 1; k <= mesh.triangles.size(); ++k) out += fmt::format("{}\n", 3 * k);
+  out += "</DataArray>\n</Polys>\n</Piece>\n</PolyData>\n</VTKFile>\n";
+  diefill::write_file_atomic(path, out);
+}
+
 }  // namespace mesh
 
 namespace mesh {

@@ -33,5 +33,7 @@ std::size_t weld_exact(TriMesh& mesh);
 // Binary STL writer (the format dies/ uses); coordinates written in `unit`.
 void write_stl(const TriMesh& mesh, const std::filesystem::path& path, LengthUnit unit,
                const std::string& header);
+// VTK XML PolyData of the surface in metres, moved by `shift`: what ParaView shows beside grains.
+void write_vtp(const TriMesh& mesh, const std::filesystem::path& path, const Vec3& shift = Vec3::Zero());
 
 }  // namespace mesh

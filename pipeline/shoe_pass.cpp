@@ -2,15 +2,43 @@
 
 #include <fmt/core.h>
 
+#include "core/atomic_file.hpp"
 #include "core/log.hpp"
 #include "dem/checkpoint.hpp"
 #include "dem/distributed.hpp"
 #include "dem/io.hpp"
 #include "dem/step.hpp"
+#include "mesh/import.hpp"
 
 namespace app {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+// The shoe's surface in its own frame (the pose at a time is its motion's position).
+mesh::TriMesh surface_of(const mesh::WallField& field) {
+  mesh::TriMesh m;
+  m.vertices = field.vertices;
+  m.triangles = field.triangles;
+  return m;
+}
+
+// `series.pvd`: ParaView opens the snapshots as one time series, with the die (fixed) and the
+// shoe at each snapshot's pose beside the grains.
+void write_series(const mesh::TriMesh& die_solid, const std::vector<double>& times, const fs::path& dir) {
+  mesh::write_vtp(die_solid, dir / "die.vtp");
+  std::string pvd = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
+  for (std::size_t k = 0; k < times.size(); ++k)
+    pvd += fmt::format("<DataSet timestep=\"{:.9g}\" part=\"0\" file=\"snapshot_{:05d}.vtu\"/>\n"
+                       "<DataSet timestep=\"{:.9g}\" part=\"1\" file=\"die.vtp\"/>\n"
+                       "<DataSet timestep=\"{:.9g}\" part=\"2\" file=\"shoe_{:05d}.vtp\"/>\n",
+                       times[k], k, times[k], times[k], k);
+  pvd += "</Collection>\n</VTKFile>\n";
+  diefill::write_file_atomic(dir / "series.pvd", pvd);
+}
+
+}  // namespace
 
 std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& walls, const ShoePlan& shoe, double table_z,
                                     dem::State settled, const fs::path& dir, bool resume) {
@@ -30,15 +58,20 @@ std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& wal
   } else {
     dem::initialize(model, state);
   }
+  const mesh::TriMesh shoe_surface = surface_of(*walls.shoe_field);
   LoopOptions loop;
   loop.until = shoe.t_motion + s.die_settle_time;
   loop.label = walls.die.name + ": filling";
   loop.checkpoint = checkpoint;
-  int snapshot = 0;
+  std::vector<double> snapshot_times;
   if (s.snapshot_every > 0)
     loop.outputs.push_back({s.snapshot_every, [&](const dem::State& st) {
-                              const fs::path file = dir / fmt::format("snapshot_{:05d}.vtu", snapshot++);
-                              dem::with_whole_state(st, [&](const dem::State& whole) { dem::write_vtu(whole, file); });
+                              const std::size_t k = snapshot_times.size();
+                              snapshot_times.push_back(st.time);
+                              dem::with_whole_state(st, [&](const dem::State& whole) {
+                                dem::write_vtu(whole, dir / fmt::format("snapshot_{:05d}.vtu", k));
+                                mesh::write_vtp(shoe_surface, dir / fmt::format("shoe_{:05d}.vtp", k), shoe.motion.position(st.time));
+                              });
                             }});
   const double density = walls.spec.materials[std::size_t(walls.powder)].density;
   loop.outputs.push_back({s.fill_curve_every, [&](const dem::State& st) { fill.curve.push_back(sample_fill(st, table_z, density, shoe)); }});
@@ -50,6 +83,7 @@ std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& wal
   };
   fill.loop = run_until(model, state, loop);
   if (fill.loop.interrupted) return std::nullopt;
+  if (!snapshot_times.empty() && dem::writes_outputs(state)) write_series(walls.die.solid, snapshot_times, dir);
   if (dem::writes_outputs(state)) fs::remove(checkpoint);
   // The outputs are written from the whole state, on rank 0 of a split run.
   if (state.exchange) state = dem::gathered(state);

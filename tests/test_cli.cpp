@@ -70,6 +70,9 @@ TEST(Cli, SdfRejectsBadMeshesClearly) {
   mesh::write_stl(ring, dir / "ring_in_metres.stl", mesh::LengthUnit::m, "ring, m");
   expect_bad_input("sdf " + d + "/ring_in_metres.stl", "ring_in_metres.stl", "--units m");
   expect_bad_input("sdf --units furlong " + d + "/ring.stl", "--units", "unknown length unit");
+  expect_bad_input("run --units furlong " + d + "/ring.stl", "die.units", "unknown length unit");
+  expect_bad_input("sdf --up sideways " + d + "/ring.stl", "--up", "not a direction");
+  expect_bad_input("run --up sideways " + d + "/ring.stl", "die.up", "not a direction");
   expect_bad_input("sdf --voxel -1 " + d + "/ring.stl", "voxel", "positive");
 }
 

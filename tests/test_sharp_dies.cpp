@@ -2,12 +2,14 @@
 // splined bore, the 1.2 mm slot), triangulated as a CAD extrusion is, through the pipeline: it
 // runs without a stop, loses no grain, and at every snapshot no grain's centre lies inside the
 // die solid by Embree's exact inside test (a grain pushed through a wall, or a wall query with the
-// wrong sign, would put one there).
+// wrong sign, would put one there). Its snapshots open in ParaView as one series (series.pvd).
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <filesystem>
+
+#include <nlohmann/json.hpp>
 
 #include "dem/io.hpp"
 #include "mesh/exact.hpp"
@@ -64,6 +66,25 @@ TEST_P(SharpFeatureDie, FillsWithNoGrainInsideTheDieSolid) {
   EXPECT_EQ(inside, 0u) << d.name << ": grain centres inside the die solid over " << snapshots << " snapshots";
   std::printf("%s: %zu snapshots, %zu grain centres inside the solid, closest centre %.3f radii from it, fill ratio %.4f\n",
               d.name, snapshots, inside, closest, run.report["fill"]["fill_ratio"].get<double>());
+
+  // The snapshots as one time series, read through VTK as ParaView reads it: the times rising
+  // from 0 by output.snapshot_every (to the step), every grain in each, the die's surface with its table at
+  // z = 0, and the shoe moving along +x.
+  const test::Run py = test::run_command("/usr/bin/python3 " + (test::source_dir() / "tests" / "read_series.py").string() + " " +
+                                         (dir / "out" / d.name).string() + " 2>&1");
+  ASSERT_EQ(py.status, 0) << py.output;
+  const nlohmann::json series = nlohmann::json::parse(py.output);
+  const auto times = series["times"].get<std::vector<double>>();
+  ASSERT_EQ(times.size(), snapshots - 1) << "every snapshot but the final state's file";
+  EXPECT_TRUE(series["same_times_in_every_part"].get<bool>());
+  EXPECT_EQ(times.front(), 0.0);
+  const double dt = run.report["timing"]["dt_s"].get<double>();  // a snapshot falls on the step nearest its time
+  for (std::size_t k = 1; k + 1 < times.size(); ++k) EXPECT_NEAR(times[k] - times[k - 1], 0.05, dt) << k;
+  for (const auto& n : series["grains"]) EXPECT_EQ(n, run.report["particles"]["inserted"]);
+  EXPECT_GT(series["die_triangles"].get<int>(), int(cavity.triangles.size()));
+  EXPECT_NEAR(series["die_bounds"][5].get<double>(), 0.0, 1e-9) << "the table's top";
+  const auto shoe_x = series["shoe_x_min"].get<std::vector<double>>();
+  EXPECT_LT(shoe_x.front(), shoe_x.back());
 }
 
 INSTANTIATE_TEST_SUITE_P(Dies, SharpFeatureDie,
