@@ -200,6 +200,18 @@ dem::State clump_lattice(double speed) {
   return s;
 }
 
+// The clump lattice in a box of planes, whole on every rank and split, both initialized.
+struct ClumpScene {
+  dem::ModelSpec spec = box_spec(true);
+  dem::State whole = clump_lattice(0.3);
+  dem::Model model = dem::compile_model(spec, whole, "mpi clumps");
+  dem::State part = split(whole);
+  ClumpScene() {
+    dem::initialize(model, whole);
+    dem::initialize(model, part);
+  }
+};
+
 // Every rank's owned clumps against the whole scene's (which created them in the order of their
 // first member's id): the count exact, every member owned with its body, centre and velocity to
 // rounding.
@@ -472,12 +484,9 @@ TEST(MpiSplit, MomentumIsConservedInFreeFlight) {
 // force is the whole scene's within 1e-12 of the largest, every body's centre and velocity to
 // rounding, every clump held once; gathered on rank 0, the bodies are the whole scene's.
 TEST(MpiSplit, ClumpsLiveWholeOnOneRankAndMatchTheWholeScene) {
-  const dem::ModelSpec spec = box_spec(true);
-  dem::State whole = clump_lattice(0.3);
-  const dem::Model model = dem::compile_model(spec, whole, "mpi clumps");
-  dem::State part = split(whole);
-  dem::initialize(model, whole);
-  dem::initialize(model, part);
+  ClumpScene scene;
+  const dem::Model& model = scene.model;
+  dem::State &whole = scene.whole, &part = scene.part;
   if (world_size() > 1) {
     EXPECT_GT(part.ghosts, 100u);
   }
@@ -516,12 +525,9 @@ TEST(MpiSplit, ClumpsLiveWholeOnOneRankAndMatchTheWholeScene) {
 // checkpoint resumed split: one step after each, every member's force is that of the run that
 // wrote it, stepped on, within 1e-12 of the largest (bodies, members and springs came back).
 TEST(MpiCheckpoint, ClumpsResumeWithTheSameForces) {
-  const dem::ModelSpec spec = box_spec(true);
-  dem::State whole = clump_lattice(0.3);
-  const dem::Model model = dem::compile_model(spec, whole, "mpi clumps");
-  dem::State part = split(whole);
-  dem::initialize(model, whole);
-  dem::initialize(model, part);
+  ClumpScene scene;
+  const dem::Model& model = scene.model;
+  dem::State &whole = scene.whole, &part = scene.part;
   for (int n = 0; n < 50; ++n) dem::step(model, whole), dem::step(model, part);
   const std::filesystem::path folder = checkpoint_of(world_size()).concat("-clumps");
   if (world_rank() == 0) {
