@@ -1,5 +1,5 @@
 #pragma once
-// Which way a die's opening faces (docs/ARCHITECTURE.md, "Dies"): a cavity mesh from CAD often
+// Which way a die's opening faces (docs/ARCHITECTURE.md, "Walls as signed-distance fields"): a cavity mesh from CAD often
 // lies on its side. The opening is a flat face at the mesh's extreme along one axis; the die is
 // turned (a rotation, never a mirror) so that it faces +z, the table's side.
 #include <optional>
