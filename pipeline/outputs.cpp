@@ -5,11 +5,13 @@
 
 #include "core/atomic_file.hpp"
 #include "core/log.hpp"
+#include "core/sha256.hpp"
 #include "dem/io.hpp"
 #include "dem/step.hpp"
 #include "pipeline/density_stage.hpp"
 #include "pipeline/fill_curve.hpp"
 #include "pipeline/pictures.hpp"
+#include "scene/physics_keys.hpp"
 
 namespace app {
 
@@ -21,7 +23,7 @@ namespace {
 nlohmann::json write_density_field(const FillRecord& r, const fs::path& dir) {
   if (r.census.cavity.empty()) {
     diefill::log::warn("{}: no grain entered the cavity; no density field", r.walls.die.name);
-    return {{"mass_kg", 0.0}, {"fill_ratio", 0.0}};
+    return {{"mass_kg", 0.0}, {"fill_ratio", 0.0}, {"voxel_m", 0.0}};
   }
   DensitySettings ds;
   ds.voxel_m = r.scene.density_voxel > 0 ? r.scene.density_voxel : 2 * r.grains.diameter;
@@ -31,7 +33,9 @@ nlohmann::json write_density_field(const FillRecord& r, const fs::path& dir) {
   field.field.metadata["coarse_graining"] = fmt::format("{}", r.grains.alpha);
   field.field.metadata["die"] = r.walls.die.name;
   write_density(field, dir);
-  return statistics_json(field.stats);
+  nlohmann::json fill = statistics_json(field.stats);
+  fill["voxel_m"] = ds.voxel_m;
+  return fill;
 }
 
 // The fill curve (CSV and chart; it ends at the field's mass, fill.mass_kg) and what the report
@@ -45,6 +49,14 @@ nlohmann::json write_fill_curve_outputs(const FillRecord& r, const fs::path& dir
   return {{"cavity_capacity_kg", capacity},
           {"strike_off_s", strike_off},
           {"curve", "fill_curve.csv"}};
+}
+
+// Of every key that shapes the result (not where it is written, nor how fast) and the materials:
+// runs with equal hashes and seeds are the same scene.
+std::string scene_hash(const PipelineScene& s) {
+  std::string text;
+  for (const Shapes what : {Shapes::die, Shapes::settling, Shapes::run}) text += shaping_values(pipeline_keys(), what, s);
+  return diefill::sha256_hex(text + describe_materials(s.spec));
 }
 
 nlohmann::json report_json(const FillRecord& r, const nlohmann::json& fill) {
@@ -89,6 +101,11 @@ nlohmann::json report_json(const FillRecord& r, const nlohmann::json& fill) {
         {"ranks", r.ranks},
         {"threads_per_rank", omp_get_max_threads()},
         {"stages", stage_times_json(r.fill.loop.times)}}},
+      {"run",
+       {{"version", DIEFILL_VERSION},
+        {"dem_source_sha256", std::string(dem::source_hash())},
+        {"seed", s.seed},
+        {"scene_sha256", scene_hash(s)}}},
       {"final_state_sha256", dem::state_hash(r.fill.state)},
       {"stability",
        {{"max_overlap_rel", r.fill.loop.max_overlap_rel},

@@ -8,7 +8,9 @@
 #include <cmath>
 #include <numbers>
 #include <fstream>
+#include <functional>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "pipeline/die_fill.hpp"
@@ -139,6 +141,37 @@ TEST(Pipeline, FillCurveRisesWhileTheDieFillsAndEndsAtTheReportsMass) {
   EXPECT_DOUBLE_EQ(report["fill"]["cavity_capacity_kg"].get<double>(),
                    report["die"]["cavity_volume_m3"].get<double>() * report["powder"]["material_density"].get<double>());
   EXPECT_TRUE(fs::exists(output_of("ring") / "fill_curve.png"));
+}
+
+// Every key of report.json has its row in docs/INTERFACE.md's table (with its unit and meaning),
+// and every row names a key the report holds.
+TEST(Pipeline, EveryReportKeyIsDocumented) {
+  const nlohmann::json& report = run("ring", 0.1, 1);
+  std::set<std::string> documented, written;
+  std::ifstream doc(test::source_dir() / "docs" / "INTERFACE.md");
+  bool in_table = false;
+  for (std::string line; std::getline(doc, line);) {
+    if (line.starts_with("- **Report** (`report.json`)")) in_table = true;
+    else if (in_table && line.starts_with("- **")) break;
+    if (in_table && line.starts_with("| `")) documented.insert(line.substr(3, line.find('`', 3) - 3));
+  }
+  // Leaves only, with the profiles' axes and the percentiles as the table writes them.
+  const std::function<void(const nlohmann::json&, const std::string&)> walk = [&](const nlohmann::json& j, const std::string& path) {
+    if (!j.is_object()) {
+      written.insert(path);
+      return;
+    }
+    for (const auto& [key, value] : j.items()) {
+      std::string name = key;
+      if (path.ends_with("profiles")) name = "<axis>";
+      if (path.ends_with("percentiles")) name = "p<N>";
+      walk(value, path.empty() ? name : path + "." + name);
+    }
+  };
+  walk(report, "");
+  ASSERT_GT(documented.size(), 50u) << "the table was not found";
+  for (const std::string& key : written) EXPECT_TRUE(documented.count(key)) << key << " is not in docs/INTERFACE.md";
+  for (const std::string& key : documented) EXPECT_TRUE(written.count(key)) << key << " is documented but not written";
 }
 
 TEST(Pipeline, SameSceneAndSeedGiveTheSameReportAndGrains) {
