@@ -125,7 +125,7 @@ TEST(MpiRun, ClumpGrainsFillTheRingOverTwoRanks) {
   EXPECT_GT(r["powder"]["spheres_per_grain"].get<int>(), 1);
   const double d = r["powder"]["grain_diameter_m"].get<double>();
   const double expected = double(p["inserted"].get<std::int64_t>()) * std::numbers::pi / 6 * d * d * d;
-  EXPECT_NEAR(r["powder"]["grain_volume_m3"].get<double>(), expected, 1e-9 * expected);
+  EXPECT_NEAR(r["powder"]["total_grain_volume_m3"].get<double>(), expected, 1e-9 * expected);
 }
 
 // Two grains of 200 overlap by 1.4 radii at the start, on one rank: every rank stops at the first

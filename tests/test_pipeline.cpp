@@ -297,7 +297,7 @@ TEST(Pipeline, ClumpGrainsFillTheRingWithoutLeaking) {
   EXPECT_GT(r["powder"]["spheres_per_grain"].get<int>(), 1);
   const double d = r["powder"]["grain_diameter_m"].get<double>();
   const double expected = double(p["inserted"].get<std::int64_t>()) * std::numbers::pi / 6 * d * d * d;
-  EXPECT_NEAR(r["powder"]["grain_volume_m3"].get<double>(), expected, 1e-9 * expected);
+  EXPECT_NEAR(r["powder"]["total_grain_volume_m3"].get<double>(), expected, 1e-9 * expected);
   std::printf("ring with capsule clumps: %lld of %lld grains in the cavity, fill ratio %.4f\n",
               (long long)p["in_cavity"].get<std::int64_t>(), (long long)p["inserted"].get<std::int64_t>(),
               r["fill"]["fill_ratio"].get<double>());
