@@ -41,18 +41,10 @@ int run_simulate(const SimulateCommand& c) {
   diefill::log::info("{}: {} grains, time step {:.3g} s (Rayleigh {:.3g} s, collision {:.3g} s), skin {:.3g} m",
                      scene.source, grains, model.dt, model.dt_rayleigh, model.dt_hertz, model.skin);
 
-  std::unique_ptr<dem::TrajectoryWriter> trajectory;
-  if (!ranks) {
+  std::unique_ptr<dem::TrajectoryWriter> trajectory;  // rank 0 opens it; should that fail, every rank stops
+  dem::run_and_agree(ranks.get(), root, [&] {
     if (scene.output.trajectory) trajectory = std::make_unique<dem::TrajectoryWriter>(dir / "trajectory.csv");
-  } else {
-    std::exception_ptr failure;  // rank 0 opens it; should that fail, every rank stops
-    try {
-      if (scene.output.trajectory && root) trajectory = std::make_unique<dem::TrajectoryWriter>(dir / "trajectory.csv");
-    } catch (...) {
-      failure = std::current_exception();
-    }
-    dem::agree_on_failure(*ranks, failure);
-  }
+  });
   int snapshot = 0;
   LoopOptions loop;
   loop.until = scene.duration;

@@ -282,31 +282,18 @@ void write_checkpoint(const Model& model, const State& state, const std::filesys
     return;
   }
   SplitImage image = image_of(state);
-  std::exception_ptr failure;
-  if (writes_outputs(state)) {
-    try {
-      w.bytes.append(split_magic, sizeof split_magic);
-      w.bytes.append(model.hash);
-      split_fields(w, image);
-      diefill::write_file_atomic(path, w.bytes);
-    } catch (...) {
-      failure = std::current_exception();
-    }
-  }
-  agree_on_failure(*state.exchange, failure);
+  run_and_agree(state.exchange.get(), writes_outputs(state), [&] {
+    w.bytes.append(split_magic, sizeof split_magic);
+    w.bytes.append(model.hash);
+    split_fields(w, image);
+    diefill::write_file_atomic(path, w.bytes);
+  });
 }
 
 State read_checkpoint(const Model& model, const std::filesystem::path& path, std::shared_ptr<Exchange> exchange) {
-  if (!exchange) return read_whole_or_split(model, path, nullptr);
   // Every rank reads the file; should one fail, all stop.
-  std::exception_ptr failure;
   State s;
-  try {
-    s = read_whole_or_split(model, path, exchange);
-  } catch (...) {
-    failure = std::current_exception();
-  }
-  agree_on_failure(*exchange, failure);
+  run_and_agree(exchange.get(), true, [&] { s = read_whole_or_split(model, path, exchange); });
   return s;
 }
 

@@ -215,19 +215,20 @@ State gathered(const State& s) {
 void with_whole_state(const State& s, const std::function<void(const State&)>& use) {
   if (!s.exchange) return use(s);
   const State whole = gathered(s);
+  run_and_agree(s.exchange.get(), writes_outputs(s), [&] { use(whole); });
+}
+
+void run_and_agree(Exchange* exchange, bool here, const std::function<void()>& work) {
+  if (!exchange) return work();
   std::exception_ptr failure;
-  if (writes_outputs(s)) {
+  if (here) {
     try {
-      use(whole);
+      work();
     } catch (...) {
       failure = std::current_exception();
     }
   }
-  agree_on_failure(*s.exchange, failure);
-}
-
-void agree_on_failure(Exchange& exchange, const std::exception_ptr& failure) {
-  if (exchange.max(failure ? 1.0 : 0.0) == 0) return;
+  if (exchange->max(failure ? 1.0 : 0.0) == 0) return;
   if (failure) std::rethrow_exception(failure);
   throw diefill::InputError("", "", "another rank could not go on (it says why)", "See rank 0's message");
 }

@@ -4,7 +4,6 @@
 // outputs, and the contact histories that travel with grains, keyed by global ids. Every call
 // that takes a split state is collective: every rank makes it, in the same order. On a single
 // process (no exchange) each is the plain thing and makes no call.
-#include <exception>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -75,8 +74,9 @@ State gathered(const State& state);
 // process, the gathered one on rank 0 of a split. A failure there (a full disk) ends the call on
 // every rank: rank 0 rethrows it, the others throw InputError.
 void with_whole_state(const State& state, const std::function<void(const State&)>& use);
-// After a step some ranks may have failed in (writing a file, reading a cache): every rank learns
-// it; the failed ones rethrow their error, the others throw InputError. Collective.
-void agree_on_failure(Exchange& exchange, const std::exception_ptr& failure);
+// Runs `work` where `here` says (writing a file on rank 0, reading one on every rank), then every
+// rank learns whether it failed anywhere: the failed ones rethrow their error, the others throw
+// InputError. Collective. No exchange: runs `work`, its error unchanged.
+void run_and_agree(Exchange* exchange, bool here, const std::function<void()>& work);
 
 }  // namespace dem

@@ -30,24 +30,29 @@ std::vector<GrainRef> grains_of(const dem::State& s) {
   return grains;
 }
 
-// The grain's volume as spheres for binning: a clump's members weighted so that they add up to
-// the real grain's volume, counted once however much they overlap.
+// The grain's volume as spheres for binning (member_weight).
 void add_volume(const dem::State& s, const GrainRef& g, std::vector<post::Grain>& out) {
   if (g.body < 0) {
     out.push_back({s.x[g.index], s.radius[g.index], 1.0});
     return;
   }
   const dem::Bodies& b = s.bodies;
-  const auto first = std::size_t(b.member_start[g.index]), last = std::size_t(b.member_start[g.index + 1]);
-  double members = 0;
-  for (std::size_t m = first; m < last; ++m) members += 4.0 / 3.0 * std::numbers::pi * std::pow(s.radius[std::size_t(b.member[m])], 3);
-  for (std::size_t m = first; m < last; ++m) {
-    const std::size_t i = std::size_t(b.member[m]);
-    out.push_back({s.x[i], s.radius[i], b.volume[g.index] / members});
+  const double weight = member_weight(s, g.index);
+  for (std::int32_t m = b.member_start[g.index]; m < b.member_start[g.index + 1]; ++m) {
+    const std::size_t i = std::size_t(b.member[std::size_t(m)]);
+    out.push_back({s.x[i], s.radius[i], weight});
   }
 }
 
 }  // namespace
+
+double member_weight(const dem::State& s, std::size_t body) {
+  const dem::Bodies& b = s.bodies;
+  double members = 0;
+  for (std::int32_t m = b.member_start[body]; m < b.member_start[body + 1]; ++m)
+    members += 4.0 / 3.0 * std::numbers::pi * std::pow(s.radius[std::size_t(b.member[std::size_t(m)])], 3);
+  return b.volume[body] / members;
+}
 
 Census count_grains(const dem::State& state, double table_z, const ShoePlan& shoe) {
   Census c;

@@ -18,6 +18,10 @@ struct Census {
   double grain_volume_m3 = 0;           // of every grain (a clump's true volume, not its spheres')
 };
 
+// What each member sphere of clump `body` counts for when the grains are binned: the members
+// weighted so that they add up to the real grain's volume, counted once however much they overlap.
+double member_weight(const dem::State& state, std::size_t body);
+
 Census count_grains(const dem::State& state, double table_z, const ShoePlan& shoe);
 // InputError naming the die when a grain left through it; a warning for grains spilled beside the
 // shoe (counted in the report, not in the fill).

@@ -39,18 +39,10 @@ FillWalls walls_rank0_first(const PipelineScene& s, const DieSource& source, con
                             const std::shared_ptr<dem::Exchange>& ranks) {
   if (!ranks || ranks->ranks() == 1) return prepare_walls(s, source, grains, shoe);
   FillWalls walls;
-  const auto prepare = [&] {
-    std::exception_ptr failure;
-    try {
-      walls = prepare_walls(s, source, grains, shoe);
-    } catch (...) {
-      failure = std::current_exception();
-    }
-    return failure;
-  };
+  const auto prepare = [&] { walls = prepare_walls(s, source, grains, shoe); };
   const bool first = ranks->rank() == 0;
-  dem::agree_on_failure(*ranks, first ? prepare() : nullptr);
-  dem::agree_on_failure(*ranks, first ? nullptr : prepare());
+  dem::run_and_agree(ranks.get(), first, prepare);
+  dem::run_and_agree(ranks.get(), !first, prepare);
   return walls;
 }
 

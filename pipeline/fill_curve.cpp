@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "core/atomic_file.hpp"
+#include "pipeline/census.hpp"
 
 namespace app {
 
@@ -31,18 +32,17 @@ FillSample sample_fill(const dem::State& s, double table_z, double material_dens
       ++out.grains;
       volume += volume_below(s.radius[i], s.x[i].z() - table_z);
     }
-  // A clump's members weighted so that they add up to the grain's volume (census.cpp).
+  // A clump's members weighted as the density field bins them (census.hpp).
   const dem::Bodies& b = s.bodies;
   for (std::size_t k = 0; k < b.size(); ++k) {
     if (!b.active[k] || b.x[k].z() >= table_z) continue;
     ++out.grains;
-    double members = 0, below = 0;
+    double below = 0;
     for (std::int32_t m = b.member_start[k]; m < b.member_start[k + 1]; ++m) {
       const std::size_t i = std::size_t(b.member[std::size_t(m)]);
-      members += volume_below(s.radius[i], -s.radius[i]);
       below += volume_below(s.radius[i], s.x[i].z() - table_z);
     }
-    volume += b.volume[k] * below / members;
+    volume += member_weight(s, k) * below;
   }
   if (s.exchange) out.grains = s.exchange->sum(out.grains), volume = s.exchange->sum(volume);
   out.mass = volume * material_density;

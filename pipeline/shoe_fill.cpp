@@ -189,18 +189,9 @@ std::optional<SettledShoe> fill_and_settle_shoe(const PipelineScene& s, const Fi
     dem::with_whole_state(settled->state, [&](const dem::State& whole) { dem::write_particles_csv(whole, file); });
   }
   // Every run, cached or not, split or not, starts from the file's numbers.
-  const auto read = [&] { return dem::read_particles_csv(file, walls.powder, walls.spec.materials[std::size_t(walls.powder)].density); };
-  if (!ranks) {
-    out.state = read();
-  } else {
-    std::exception_ptr failure;
-    try {
-      out.state = read();
-    } catch (...) {
-      failure = std::current_exception();
-    }
-    dem::agree_on_failure(*ranks, failure);
-  }
+  dem::run_and_agree(ranks.get(), true, [&] {
+    out.state = dem::read_particles_csv(file, walls.powder, walls.spec.materials[std::size_t(walls.powder)].density);
+  });
   out.state = dem::share_of(std::move(out.state), ranks);
   out.requested = grains.count;
   out.inserted = std::size_t(ranks ? ranks->sum(std::int64_t(out.state.size())) : std::int64_t(out.state.size()));
