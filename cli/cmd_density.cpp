@@ -42,15 +42,14 @@ int run_density(const DensityCommand& c) {
   s.voxel_m = c.voxel_mm > 0 ? c.voxel_mm * 1e-3 : 4 * r_max;
   s.method = c.method;
   s.width_m = c.width_mm * 1e-3;
-  DensityResult result = compute_density(grains, die, walls, material_density, s, c.particles.string());
-  // The same metadata as the pipeline's field (docs/INTERFACE.md, "density.vdb").
-  result.field.metadata["coarse_graining"] = fmt::format("{}", c.coarse_graining);
-  result.field.metadata["die"] = die.name;
+  s.smoothed_width_m = c.smoothed_width_mm * 1e-3;
+  s.coarse_graining = c.coarse_graining;
+  const DensityResult result = compute_density(grains, die, walls, material_density, s, c.particles.string());
   diefill::StagingFolder out(c.output);
   write_density(result, out.path());
   nlohmann::json report = {{"die", {{"name", die.name}, {"source", die.source}, {"sha256", die.sha256}}},
                            {"particles", {{"source", c.particles.string()}, {"grains", grains.size()}}},
-                           {"density", {{"voxel_m", s.voxel_m}, {"method", s.method}, {"material_density", material_density},
+                           {"density", {{"voxel_m", s.voxel_m}, {"method", s.method}, {"smoothed_width_m", s.smoothed_width_m}, {"material_density", material_density},
                                         {"coarse_graining", c.coarse_graining}}},
                            {"fill", statistics_json(result.stats)}};
   diefill::write_file_atomic(out / "density.json", report.dump(2) + "\n");

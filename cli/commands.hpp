@@ -77,6 +77,7 @@ struct DensityCommand {
   double voxel_mm = 0;        // 0: four grain radii
   std::string method = "exact";
   double width_mm = 0;        // Gaussian width (0: one voxel)
+  double smoothed_width_mm = 0;  // > 0: also the smoothed field of this width
   double material_density = 0;  // 0: from the particle file
   double coarse_graining = 1;    // α of the file's grains over the real powder's (1: they are the powder)
 };

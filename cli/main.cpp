@@ -84,6 +84,8 @@ void add_density(CLI::App& root, app::DensityCommand& c, std::function<int()>& a
   cmd->add_option("--voxel", c.voxel_mm, "Voxel edge [mm] (default: four grain radii)");
   cmd->add_option("--method", c.method, "exact (volume split exactly) or gaussian (kernel)")->capture_default_str();
   cmd->add_option("--width", c.width_mm, "Gaussian width [mm] (default: one voxel)");
+  cmd->add_option("--smoothed-width", c.smoothed_width_mm,
+                  "Also write the smoothed field (Gaussian of this width [mm], on voxels as wide) beside the main one");
   cmd->add_option("--material-density", c.material_density, "Grain material density [kg/m³] (default: from the file)");
   cmd->add_option("--coarse-graining", c.coarse_graining,
                   "The file's grains over the real powder's size, recorded in the field (1: they are the powder)")

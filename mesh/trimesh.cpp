@@ -22,6 +22,27 @@ double signed_volume(const TriMesh& mesh) {
   return six_volume / 6.0;
 }
 
+std::vector<std::array<double, 4>> plane_section(const TriMesh& mesh, int axis, double at) {
+  const int u = axis == 0 ? 1 : 0, v = axis == 2 ? 1 : 2;
+  std::vector<std::array<double, 4>> segments;
+  for (const Triangle& t : mesh.triangles) {
+    std::array<double, 4> segment{};
+    int ends = 0;
+    for (int e = 0; e < 3; ++e) {
+      const Vec3& a = mesh.vertices[std::size_t(t[std::size_t(e)])];
+      const Vec3& b = mesh.vertices[std::size_t(t[std::size_t((e + 1) % 3)])];
+      const double sa = a[axis] - at, sb = b[axis] - at;
+      if ((sa >= 0) == (sb >= 0)) continue;
+      const Vec3 p = a + (b - a) * (sa / (sa - sb));
+      segment[std::size_t(2 * ends)] = p[u];
+      segment[std::size_t(2 * ends + 1)] = p[v];
+      ++ends;
+    }
+    if (ends == 2) segments.push_back(segment);
+  }
+  return segments;
+}
+
 double metres_per_unit(LengthUnit unit) {
   switch (unit) {
     case LengthUnit::mm: return 1e-3;

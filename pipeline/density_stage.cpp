@@ -11,52 +11,124 @@ namespace app {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// The cavity's box: the free side of the tool below the table (or the inside of a container),
+// and the die's axis, which the sections pass through.
+struct CavityBox {
+  post::Vec3 lo, hi, centre;
+  bool container = false;
+};
+
+CavityBox cavity_box(const mesh::PreparedDie& die) {
+  CavityBox c;
+  c.container = die.sdf.metadata().count("role") && die.sdf.metadata().at("role") == "container";
+  const mesh::Box box = die.after.bbox;
+  c.lo = box.lo;
+  c.hi = post::Vec3(box.hi.x(), box.hi.y(), c.container ? box.hi.z() : die.table_z);
+  c.centre = post::Vec3(0.5 * (c.lo.x() + c.hi.x()), 0.5 * (c.lo.y() + c.hi.y()), c.hi.z());
+  return c;
+}
+
+// The grains binned on voxels of edge `voxel` and corrected for the walls: exactly, or by the
+// Gaussian kernel of `width` over the identically smoothed cavity (the kernel method).
+post::DensityField binned_field(const std::vector<post::Grain>& grains, const CavityBox& c,
+                                const mesh::WallField& walls, double voxel,
+                                const std::string& method, double width, const DensitySettings& s) {
+  post::DensityField f;
+  const post::Vec3 reach = post::Vec3::Constant(method == "gaussian" ? 3 * width : 0.0);  // every kernel whole
+  f.grid = post::grid_covering(c.lo - reach, c.hi + reach, voxel,
+                               post::Vec3(c.centre.x(), c.centre.y(), c.container ? c.lo.z() : c.hi.z()));
+  f.centre = c.centre;
+  f.min_cavity = s.min_cavity;
+  // The cavity lies within its bounding box. Bounding by the box matters where the grid reaches
+  // past the die's field (coarse voxels below a thin table): there the field reads "free".
+  const post::CavityVolumes cavity =
+      post::cavity_fractions(f.grid, [&](const post::Vec3& p) { return walls.signed_distance(p); }, c.lo, c.hi, s.depth);
+  f.cavity = cavity.fraction;
+  if (method == "exact") {
+    post::bin_exact(grains, f.grid, f.solid);
+    f.corrected = post::correct_for_walls(f.grid, f.solid, f.cavity, s.min_cavity);
+  } else if (method == "gaussian") {
+    post::bin_gaussian(grains, f.grid, width, f.solid);
+    const std::vector<double> smoothed_cavity = post::smooth_gaussian(f.grid, cavity, width);
+    f.corrected = post::correct_for_walls(f.grid, f.solid, smoothed_cavity, s.min_cavity);
+    f.metadata["width_m"] = fmt::format("{:.9g}", width);
+  } else {
+    throw diefill::InputError("density", "method", "'" + method + "' is not a binning method", "Use exact or gaussian");
+  }
+  f.metadata["method"] = method;
+  return f;
+}
+
+post::Outlines outlines_of(const mesh::TriMesh& cavity, const CavityBox& c, double voxel) {
+  const double below_opening = c.hi.z() - 0.25 * std::min(voxel, c.hi.z() - c.lo.z());
+  return {mesh::plane_section(cavity, 2, below_opening), mesh::plane_section(cavity, 1, c.centre.y()),
+          mesh::plane_section(cavity, 0, c.centre.x())};
+}
+
+}  // namespace
+
+std::vector<post::Region> fill_regions(const post::VoxelGrid& g, const post::Vec3& centre, double floor_z, double table_z,
+                                       double grain_diameter, const std::function<double(const post::Vec3&)>& distance_to_wall) {
+  std::vector<post::Region> regions = {{"near_wall", {}}, {"core", {}}, {"leading_half", {}}, {"trailing_half", {}}, {"bottom_quarter", {}}};
+  for (post::Region& r : regions) r.share.assign(g.size(), 0.0);
+  const double bottom = floor_z + 0.25 * (table_z - floor_z);
+  for (int i = 0; i < g.nx; ++i)
+    for (int j = 0; j < g.ny; ++j)
+      for (int k = 0; k < g.nz; ++k) {
+        const std::size_t n = g.index(i, j, k);
+        const post::Vec3 p = g.centre(i, j, k);
+        const bool near = distance_to_wall(p) < grain_diameter;
+        regions[0].share[n] = near, regions[1].share[n] = !near;
+        const double side = (p.x() - centre.x()) / g.voxel;  // the voxel row on the centre: half each
+        regions[2].share[n] = side < -1e-6 ? 1.0 : side > 1e-6 ? 0.0 : 0.5;
+        regions[3].share[n] = 1.0 - regions[2].share[n];
+        regions[4].share[n] = p.z() < bottom;
+      }
+  return regions;
+}
+
 DensityResult compute_density(const std::vector<post::Grain>& grains, const mesh::PreparedDie& die,
                               const mesh::WallField& walls, double material_density, const DensitySettings& s,
                               const std::string& particles_source) {
   if (!(s.voxel_m > 0)) throw diefill::InputError("density", "voxel", "must be positive", "Give the voxel edge");
-  // The cavity: the free side of the tool below the table (or the inside of a container).
-  const bool container = die.sdf.metadata().count("role") && die.sdf.metadata().at("role") == "container";
-  const double table = die.table_z;
-  const mesh::Box box = die.after.bbox;
-  const post::Vec3 lo(box.lo.x(), box.lo.y(), box.lo.z()), hi(box.hi.x(), box.hi.y(), container ? box.hi.z() : table);
-  // The cavity lies within its bounding box. Bounding by the box matters where the grid reaches
-  // past the die's field (coarse voxels below a thin table): there the field reads "free".
-  auto into_cavity = [&](const post::Vec3& p) {
-    const double into_box = std::min((p - lo).minCoeff(), (hi - p).minCoeff());
-    return std::min(walls.signed_distance(p), into_box);
-  };
+  const CavityBox c = cavity_box(die);
   std::size_t in_box = 0;
-  for (const post::Grain& g : grains)
-    in_box += (g.centre.array() >= lo.array()).all() && (g.centre.array() <= hi.array()).all();
+  double largest_radius = 0;
+  for (const post::Grain& g : grains) {
+    in_box += (g.centre.array() >= c.lo.array()).all() && (g.centre.array() <= c.hi.array()).all();
+    largest_radius = std::max(largest_radius, g.radius);
+  }
   if (in_box == 0)
     throw diefill::InputError(particles_source, "positions",
                               fmt::format("none of its {} grains lies in the cavity of {} ({:.3g} to {:.3g} mm)",
-                                          grains.size(), die.source, lo.minCoeff() * 1e3, hi.maxCoeff() * 1e3),
+                                          grains.size(), die.source, c.lo.minCoeff() * 1e3, c.hi.maxCoeff() * 1e3),
                               "Give the die the grains were simulated in, with the same units");
 
   DensityResult r;
-  post::DensityField& f = r.field;
-  f.grid = post::grid_covering(lo, hi, s.voxel_m, container ? lo.z() : table);
-  f.material_density = material_density;
-  f.cavity = post::cavity_fractions(f.grid, into_cavity, s.depth);
-  if (s.method == "exact") {
-    post::bin_exact(grains, f.grid, f.solid);
-    f.corrected = post::correct_for_walls(f.grid, f.solid, f.cavity, s.min_cavity);
-  } else if (s.method == "gaussian") {
-    const double width = s.width_m > 0 ? s.width_m : s.voxel_m;
-    post::bin_gaussian(grains, f.grid, width, f.solid);
-    // Kernel method: the smoothed solid over the identically smoothed cavity indicator.
-    const std::vector<double> smoothed_cavity = post::smooth_gaussian(f.grid, f.cavity, width);
-    f.corrected = post::correct_for_walls(f.grid, f.solid, smoothed_cavity, s.min_cavity);
-  } else {
-    throw diefill::InputError("density", "method", "'" + s.method + "' is not a binning method", "Use exact or gaussian");
+  const double width = s.width_m > 0 ? s.width_m : s.voxel_m;
+  r.field = binned_field(grains, c, walls, s.voxel_m, s.method, width, s);
+  r.field.material_density = material_density;
+  r.field.metadata["die_sha256"] = die.sha256;
+  r.field.metadata["grains"] = std::to_string(grains.size());
+  r.field.metadata["die"] = die.name;
+  r.field.metadata["coarse_graining"] = fmt::format("{}", s.coarse_graining);
+  r.stats = post::statistics(r.field);
+  if (s.smoothed_width_m > 0) {
+    r.smoothed = binned_field(grains, c, walls, s.smoothed_width_m, "gaussian", s.smoothed_width_m, s);
+    r.smoothed->material_density = material_density;
+    r.smoothed->metadata.insert(r.field.metadata.begin(), r.field.metadata.end());  // the rest: the same grains
+    r.smoothed_stats = post::statistics(*r.smoothed);
   }
-  f.metadata["die_sha256"] = die.sha256;
-  f.metadata["grains"] = std::to_string(grains.size());
-  f.metadata["method"] = s.method;
-  const post::Vec3 axis((box.lo.x() + box.hi.x()) / 2, (box.lo.y() + box.hi.y()) / 2, 0);
-  r.stats = post::statistics(f, axis, std::max(4, std::min(f.grid.nz, 40)));
+  // Regions as thin as a grain need voxels finer than one: the smoothed field's, binned exactly.
+  const post::DensityField& fine = r.smoothed ? *r.smoothed : r.field;
+  std::vector<double> fine_solid;
+  post::bin_exact(grains, fine.grid, fine_solid);
+  r.stats.regions = post::region_statistics(
+      fine.grid, fine_solid, fine.cavity,
+      fill_regions(fine.grid, c.centre, c.lo.z(), c.hi.z(), 2 * largest_radius, [&](const post::Vec3& p) { return walls.signed_distance(p); }));
+  r.outlines = outlines_of(die.cavity, c, s.voxel_m);
   return r;
 }
 
@@ -65,7 +137,13 @@ nlohmann::json statistics_json(const post::FieldStatistics& st) {
   for (const auto& [p, v] : st.percentiles) percentiles[fmt::format("p{}", p)] = v;
   nlohmann::json profiles;
   for (const post::Profile& p : st.profiles)
-    profiles[p.axis] = {{"position_m", p.position}, {"solid_fraction", p.solid_fraction}, {"cavity_volume_m3", p.cavity_volume}};
+    profiles[p.axis] = {{"position_m", p.position},
+                        {"solid_fraction", p.solid_fraction},
+                        {"spread", p.spread},
+                        {"cavity_volume_m3", p.cavity_volume}};
+  nlohmann::json regions;
+  for (const post::RegionStatistics& g : st.regions)
+    regions[g.name] = {{"fill_ratio", g.fill_ratio}, {"cavity_volume_m3", g.cavity_volume_m3}};
   return {{"mass_kg", st.mass_kg},
           {"solid_volume_m3", st.solid_volume_m3},
           {"cavity_volume_m3", st.cavity_volume_m3},
@@ -78,13 +156,16 @@ nlohmann::json statistics_json(const post::FieldStatistics& st) {
           {"solid_fraction_percentiles", percentiles},
           {"voxels", st.voxels},
           {"merged_voxels", st.merged_voxels},
-          {"profiles", profiles}};
+          {"profiles", profiles},
+          {"regions", regions}};
 }
 
 void write_density(const DensityResult& r, const fs::path& dir) {
-  post::write_vdb(r.field, dir / "density.vdb");
+  const post::DensityField* smoothed = r.smoothed ? &*r.smoothed : nullptr;
+  post::write_vdb(r.field, smoothed, dir / "density.vdb");
   post::write_vti(r.field, dir / "density.vti");
-  post::write_plot_data(r.field, r.stats, dir / "plot_data.json");
+  if (smoothed) post::write_vti(*smoothed, dir / "density_smoothed.vti");
+  post::write_plot_data(r.field, r.stats, smoothed, smoothed ? &r.smoothed_stats : nullptr, r.outlines, dir / "plot_data.json");
   draw_pictures({"density", dir.string()});
 }
 

@@ -28,13 +28,14 @@ nlohmann::json write_density_field(const FillRecord& r, const fs::path& dir) {
   DensitySettings ds;
   ds.voxel_m = r.scene.density_voxel > 0 ? r.scene.density_voxel : 2 * r.grains.diameter;
   ds.method = r.scene.density_method;
+  ds.smoothed_width_m = r.scene.density_smoothed_width > 0 ? r.scene.density_smoothed_width : 0.5 * r.grains.diameter;
+  ds.coarse_graining = r.grains.alpha;
   const double density = r.walls.spec.materials[std::size_t(r.walls.powder)].density;
-  DensityResult field = compute_density(r.census.cavity, r.walls.die, *r.walls.die_field, density, ds, r.walls.die.name);
-  field.field.metadata["coarse_graining"] = fmt::format("{}", r.grains.alpha);
-  field.field.metadata["die"] = r.walls.die.name;
+  const DensityResult field = compute_density(r.census.cavity, r.walls.die, *r.walls.die_field, density, ds, r.walls.die.name);
   write_density(field, dir);
   nlohmann::json fill = statistics_json(field.stats);
   fill["voxel_m"] = ds.voxel_m;
+  fill["smoothed_width_m"] = ds.smoothed_width_m;
   return fill;
 }
 

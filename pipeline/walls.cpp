@@ -119,7 +119,7 @@ FillWalls prepare_walls(const PipelineScene& s, const DieSource& source, const G
   FillWalls w;
   w.powder = material_named(s.spec, "powder");
   w.steel = material_named(s.spec, "steel");
-  w.cache = s.out / ".cache";
+  w.cache = s.cache.empty() ? s.out / ".cache" : s.cache;
   const mesh::DieOptions options = die_options(s, grains, shoe, source);
   w.die = mesh::prepare_die(source.file, options, w.cache);
   w.die_field = std::make_shared<const mesh::WallField>(w.die.sdf.wall_field(w.die.solid));

@@ -9,11 +9,11 @@
 
 namespace post {
 
-VoxelGrid grid_covering(const Vec3& lo, const Vec3& hi, double h, double anchor_z) {
+VoxelGrid grid_covering(const Vec3& lo, const Vec3& hi, double h, const Vec3& anchor) {
   VoxelGrid g;
   g.voxel = h;
-  g.origin = Vec3(std::floor(lo.x() / h) * h, std::floor(lo.y() / h) * h,
-                  anchor_z + std::floor((lo.z() - anchor_z) / h) * h);
+  const Vec3 face = anchor - Vec3(0.5 * h, 0.5 * h, 0);
+  g.origin = face + h * ((lo - face) / h).array().floor().matrix();
   g.nx = std::max(1, int(std::ceil((hi.x() - g.origin.x()) / h - 1e-9)));
   g.ny = std::max(1, int(std::ceil((hi.y() - g.origin.y()) / h - 1e-9)));
   g.nz = std::max(1, int(std::ceil((hi.z() - g.origin.z()) / h - 1e-9)));
@@ -42,26 +42,53 @@ void bin_exact(const std::vector<Grain>& grains, const VoxelGrid& g, std::vector
 }
 
 namespace {
-// Normalised Gaussian weights of one grain on the grid nodes within 3 widths.
-template <typename Visit>
-void gaussian_footprint(const VoxelGrid& g, const Vec3& centre, double width, Visit visit) {
+// One axis of the kernel: the weights of the nodes within 3 widths of `at`, normalised over all
+// of them, on the grid or beyond it (renormalising on the grid's nodes alone would weigh a
+// grain near the grid's edge by where the edge happens to be; weight beyond the grid is lost,
+// and fields of the kernel method reach 3 widths past the cavity, density_stage). A point takes
+// the Gaussian's values at the nodes; a segment of length `extent` around `at` (a voxel's
+// cavity along this axis) the Gaussian's integral over each node's interval of it.
+struct AxisWeights {
+  int first = 0;  // node index of weight[0]; may lie off the grid
+  std::vector<double> weight;
+};
+
+AxisWeights axis_weights(double origin, double h, double at, double width, double extent) {
+  AxisWeights a;
   const double reach = 3 * width;
-  const Vec3 lo = (centre - Vec3::Constant(reach) - g.origin) / g.voxel - Vec3::Constant(0.5);
-  const Vec3 hi = (centre + Vec3::Constant(reach) - g.origin) / g.voxel - Vec3::Constant(0.5);
-  const int i0 = std::max(0, int(std::ceil(lo.x()))), i1 = std::min(g.nx - 1, int(std::floor(hi.x())));
-  const int j0 = std::max(0, int(std::ceil(lo.y()))), j1 = std::min(g.ny - 1, int(std::floor(hi.y())));
-  const int k0 = std::max(0, int(std::ceil(lo.z()))), k1 = std::min(g.nz - 1, int(std::floor(hi.z())));
+  a.first = int(std::ceil((at - reach - origin) / h - 0.5));
+  const int last = int(std::floor((at + reach - origin) / h - 0.5));
   double total = 0;
-  for (int pass = 0; pass < 2; ++pass)
-    for (int i = i0; i <= i1; ++i)
-      for (int j = j0; j <= j1; ++j)
-        for (int k = k0; k <= k1; ++k) {
-          const double d2 = (g.centre(i, j, k) - centre).squaredNorm();
-          if (d2 > reach * reach) continue;
-          const double w = std::exp(-0.5 * d2 / (width * width));
-          if (pass == 0) total += w;
-          else visit(g.index(i, j, k), w / total);
-        }
+  for (int n = a.first; n <= last; ++n) {
+    const double u = origin + (n + 0.5) * h - at;
+    const double w = extent > 0 ? std::erf((u + 0.5 * extent) / (std::numbers::sqrt2 * width)) -
+                                      std::erf((u - 0.5 * extent) / (std::numbers::sqrt2 * width))
+                                : std::exp(-0.5 * u * u / (width * width));
+    a.weight.push_back(w);
+    total += w;
+  }
+  for (double& w : a.weight) w /= total;
+  return a;
+}
+
+// The separable kernel around `at` (a point, or a cube of side `extent`), visited on the grid.
+template <typename Visit>
+void gaussian_footprint(const VoxelGrid& g, const Vec3& at, double width, double extent, Visit visit) {
+  const AxisWeights x = axis_weights(g.origin.x(), g.voxel, at.x(), width, extent);
+  const AxisWeights y = axis_weights(g.origin.y(), g.voxel, at.y(), width, extent);
+  const AxisWeights z = axis_weights(g.origin.z(), g.voxel, at.z(), width, extent);
+  for (std::size_t a = 0; a < x.weight.size(); ++a) {
+    const int i = x.first + int(a);
+    if (i < 0 || i >= g.nx) continue;
+    for (std::size_t b = 0; b < y.weight.size(); ++b) {
+      const int j = y.first + int(b);
+      if (j < 0 || j >= g.ny) continue;
+      for (std::size_t c = 0; c < z.weight.size(); ++c) {
+        const int k = z.first + int(c);
+        if (k >= 0 && k < g.nz) visit(g.index(i, j, k), x.weight[a] * y.weight[b] * z.weight[c]);
+      }
+    }
+  }
 }
 }  // namespace
 
@@ -69,43 +96,64 @@ void bin_gaussian(const std::vector<Grain>& grains, const VoxelGrid& g, double w
   solid.resize(g.size(), 0.0);
   for (const Grain& grain : grains) {
     const double volume = grain.weight * 4.0 / 3.0 * std::numbers::pi * std::pow(grain.radius, 3);
-    gaussian_footprint(g, grain.centre, width, [&](std::size_t n, double w) { solid[n] += volume * w; });
+    gaussian_footprint(g, grain.centre, width, 0.0, [&](std::size_t n, double w) { solid[n] += volume * w; });
   }
 }
 
-std::vector<double> smooth_gaussian(const VoxelGrid& g, const std::vector<double>& field, double width) {
+std::vector<double> smooth_gaussian(const VoxelGrid& g, const CavityVolumes& cavity, double width) {
   std::vector<double> out(g.size(), 0.0);
-  for (int i = 0; i < g.nx; ++i)
-    for (int j = 0; j < g.ny; ++j)
-      for (int k = 0; k < g.nz; ++k) {
-        const double value = field[g.index(i, j, k)];
-        if (value == 0) continue;
-        gaussian_footprint(g, g.centre(i, j, k), width, [&](std::size_t n, double w) { out[n] += value * w; });
-      }
+  for (std::size_t n = 0; n < g.size(); ++n) {
+    const double value = cavity.fraction[n];
+    if (value == 0) continue;
+    gaussian_footprint(g, cavity.centroid[n], width, g.voxel, [&](std::size_t m, double w) { out[m] += value * w; });
+  }
   return out;
 }
 
 namespace {
-double cube_fraction(const std::function<double(const Vec3&)>& distance, const Vec3& centre, double a, int depth) {
+// Fractions within rounding of 0 or 1 are 0 or 1 (a face half a cube away reads 1e-17, not 0).
+double snapped(double fraction) { return fraction < 1e-12 ? 0.0 : fraction > 1 - 1e-12 ? 1.0 : fraction; }
+
+// The part of a cube inside a region, over the cube's volume, and its first moment (the part's
+// centroid times that fraction).
+struct CubePart {
+  double fraction = 0;
+  Vec3 moment = Vec3::Zero();
+};
+
+// `distance` is into the cavity: the free side of the walls within the box.
+CubePart cube_part(const std::function<double(const Vec3&)>& distance, const Vec3& centre, double a, int depth) {
   const double d = distance(centre);
   const double half_diagonal = 0.5 * std::sqrt(3.0) * a;
-  if (d >= half_diagonal) return 1.0;
-  if (d <= -half_diagonal) return 0.0;
-  if (depth == 0) return std::clamp(0.5 + d / a, 0.0, 1.0);
-  double sum = 0.0;
-  for (int c = 0; c < 8; ++c)
-    sum += cube_fraction(distance, centre + 0.25 * a * Vec3((c & 1) ? 1 : -1, (c & 2) ? 1 : -1, (c & 4) ? 1 : -1),
-                         0.5 * a, depth - 1);
-  return sum / 8.0;
+  if (d >= half_diagonal) return {1.0, centre};
+  if (d <= -half_diagonal) return {};
+  if (depth == 0) {
+    const double free = snapped(std::clamp(0.5 + d / a, 0.0, 1.0));
+    return {free, free * centre};
+  }
+  CubePart sum;
+  for (int c = 0; c < 8; ++c) {
+    const CubePart child =
+        cube_part(distance, centre + 0.25 * a * Vec3((c & 1) ? 1 : -1, (c & 2) ? 1 : -1, (c & 4) ? 1 : -1), 0.5 * a, depth - 1);
+    sum.fraction += child.fraction / 8.0, sum.moment += child.moment / 8.0;
+  }
+  return sum;
 }
 }  // namespace
 
-std::vector<double> cavity_fractions(const VoxelGrid& g, const std::function<double(const Vec3&)>& distance, int depth) {
-  std::vector<double> out(g.size(), 0.0);
+CavityVolumes cavity_fractions(const VoxelGrid& g, const std::function<double(const Vec3&)>& distance, const Vec3& lo,
+                               const Vec3& hi, int depth) {
+  const auto into_cavity = [&](const Vec3& p) { return std::min({distance(p), (p - lo).minCoeff(), (hi - p).minCoeff()}); };
+  CavityVolumes out{std::vector<double>(g.size(), 0.0), std::vector<Vec3>(g.size(), Vec3::Zero())};
 #pragma omp parallel for schedule(dynamic, 1)
   for (int i = 0; i < g.nx; ++i)
     for (int j = 0; j < g.ny; ++j)
-      for (int k = 0; k < g.nz; ++k) out[g.index(i, j, k)] = cube_fraction(distance, g.centre(i, j, k), g.voxel, depth);
+      for (int k = 0; k < g.nz; ++k) {
+        const std::size_t n = g.index(i, j, k);
+        const CubePart part = cube_part(into_cavity, g.centre(i, j, k), g.voxel, depth);
+        out.fraction[n] = part.fraction;
+        out.centroid[n] = part.fraction > 0 ? Vec3(part.moment / part.fraction) : g.centre(i, j, k);
+      }
   return out;
 }
 

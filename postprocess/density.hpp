@@ -32,26 +32,41 @@ struct VoxelGrid {
   double voxel_volume() const { return voxel * voxel * voxel; }
 };
 
-// The grid covering [lo, hi] with voxels of edge h, aligned so that `anchor` (the die table's
-// height, say) lies on a voxel face.
-VoxelGrid grid_covering(const Vec3& lo, const Vec3& hi, double h, double anchor_z);
+// The grid covering [lo, hi] with voxels of edge h, aligned so that a voxel's centre lies at
+// anchor.x(), anchor.y() (the die's axis: its sections are then voxel rows) and a voxel face at
+// anchor.z() (the die table: no voxel straddles the opening).
+VoxelGrid grid_covering(const Vec3& lo, const Vec3& hi, double h, const Vec3& anchor);
 
 // Adds each grain's volume inside each voxel [m³] (exact sphere-box intersections); the part of
 // a grain outside the grid is not counted.
 void bin_exact(const std::vector<Grain>& grains, const VoxelGrid& grid, std::vector<double>& solid);
 
-// Gaussian coarse graining (after MercuryCG): each grain's volume spread with a normalised
-// Gaussian of standard deviation `width`, cut at 3 widths and renormalised on the grid nodes.
+// Gaussian coarse graining (after MercuryCG): each grain's volume spread from its centre with a
+// normalised Gaussian of standard deviation `width`, cut at 3 widths along each axis and
+// normalised on the lattice of nodes (on the grid or not: a grid that is to keep every grain's
+// weight reaches 3 widths past them).
 void bin_gaussian(const std::vector<Grain>& grains, const VoxelGrid& grid, double width, std::vector<double>& solid);
-// The cavity fractions smoothed by the same kernel: the denominator of the kernel method.
-std::vector<double> smooth_gaussian(const VoxelGrid& grid, const std::vector<double>& field, double width);
+// The part of each voxel inside the cavity (0..1) and that part's centroid [m].
+struct CavityVolumes {
+  std::vector<double> fraction;
+  std::vector<Vec3> centroid;
+};
 
-// Fraction of each voxel inside the cavity, from the signed distance into it (positive inside;
-// beyond a known range a lower bound of the magnitude is enough). A cube farther from the wall
-// than its half-diagonal is wholly in or out; a cut cube is split in eight, down to `depth`
-// levels, where a cube of side a takes clamp(1/2 + d/a, 0, 1) (exact for a face-parallel wall).
-std::vector<double> cavity_fractions(const VoxelGrid& grid, const std::function<double(const Vec3&)>& distance_into_cavity,
-                                     int depth);
+// The cavity smoothed by the same kernel: the denominator of the kernel method. Each voxel's
+// cavity is taken as a cube at its centroid and the Gaussian integrated over it (as points at
+// the voxels' centres, the cavity's edge sits up to half a voxel off and a lattice's ratio read
+// 2-3 % off a voxel from the floor: measured on the ring).
+std::vector<double> smooth_gaussian(const VoxelGrid& grid, const CavityVolumes& cavity, double width);
+
+// The part of each voxel inside the cavity: the free side of the walls (`distance` positive;
+// beyond a known range a lower bound of the magnitude is enough) within the box [lo, hi] (the
+// cavity's bounds: the table's plane on top). A cube farther from the wall than its
+// half-diagonal is wholly free or not; a cut cube is split in eight, down to `depth` levels,
+// where a cube of side a takes clamp(1/2 + d/a, 0, 1) (exact for a face-parallel wall), with
+// the fractions within rounding of 0 or 1 snapped to them (else the tool's top, half a leaf
+// below the table's plane, reads 1e-17 of cavity and turns voxels outside the die into cavity).
+CavityVolumes cavity_fractions(const VoxelGrid& grid, const std::function<double(const Vec3&)>& distance, const Vec3& lo,
+                               const Vec3& hi, int depth);
 
 struct CorrectedField {
   std::vector<double> solid_fraction;  // solid volume over cavity volume, NaN outside the cavity

@@ -3,6 +3,8 @@
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -43,20 +45,33 @@ openvdb::FloatGrid::Ptr grid_of(const DensityField& f, const std::string& name, 
 
 }  // namespace
 
-void write_vdb(const DensityField& f, const std::filesystem::path& path) {
+namespace {
+
+// A field's grids under names with `prefix`; the cavity's voxels only are active.
+void add_grids(const DensityField& f, const std::string& prefix, openvdb::GridPtrVec& grids) {
+  const auto& phi = f.corrected.solid_fraction;
+  const std::size_t first = grids.size();
+  grids.push_back(grid_of(f, prefix + "solid_fraction", [&](std::size_t n) { return phi[n]; }));
+  grids.push_back(grid_of(f, prefix + "density", [&](std::size_t n) { return phi[n] * f.material_density; }));
+  grids.push_back(grid_of(f, prefix + "cavity_fraction", [&](std::size_t n) { return f.cavity[n]; }));
+  if (prefix.empty())  // the smoothed field's kernel spans the wall: it merges (almost) nothing
+    grids.push_back(grid_of(f, "merged", [&](std::size_t n) { return double(f.corrected.merged[n]); }));
+  for (std::size_t g = first; g < grids.size(); ++g) {
+    for (const auto& [key, value] : f.metadata) grids[g]->insertMeta(key, openvdb::StringMetadata(value));
+    grids[g]->insertMeta("units", openvdb::StringMetadata("m"));
+    grids[g]->insertMeta("material_density", openvdb::DoubleMetadata(f.material_density));
+    grids[g]->insertMeta("voxel_size_m", openvdb::DoubleMetadata(f.grid.voxel));
+  }
+}
+
+}  // namespace
+
+void write_vdb(const DensityField& f, const DensityField* smoothed, const std::filesystem::path& path) {
   static std::once_flag once;
   std::call_once(once, [] { openvdb::initialize(); });
   openvdb::GridPtrVec grids;
-  const auto& phi = f.corrected.solid_fraction;
-  grids.push_back(grid_of(f, "solid_fraction", [&](std::size_t n) { return phi[n]; }));
-  grids.push_back(grid_of(f, "density", [&](std::size_t n) { return phi[n] * f.material_density; }));
-  grids.push_back(grid_of(f, "cavity_fraction", [&](std::size_t n) { return f.cavity[n]; }));
-  for (auto& grid : grids) {
-    for (const auto& [key, value] : f.metadata) grid->insertMeta(key, openvdb::StringMetadata(value));
-    grid->insertMeta("units", openvdb::StringMetadata("m"));
-    grid->insertMeta("material_density", openvdb::DoubleMetadata(f.material_density));
-    grid->insertMeta("voxel_size_m", openvdb::DoubleMetadata(f.grid.voxel));
-  }
+  add_grids(f, "", grids);
+  if (smoothed) add_grids(*smoothed, "smoothed_", grids);
   diefill::PendingFile pending(path);
   openvdb::io::File file(pending.path().string());
   file.write(grids);
@@ -86,46 +101,126 @@ void write_vti(const DensityField& f, const std::filesystem::path& path) {
   array("solid_fraction", [&](std::size_t n) { return phi[n]; });
   array("density", [&](std::size_t n) { return phi[n] * f.material_density; });
   array("cavity_fraction", [&](std::size_t n) { return f.cavity[n]; });
+  array("merged", [&](std::size_t n) { return double(f.corrected.merged[n]); });
   out += "</CellData>\n</Piece>\n</ImageData>\n</VTKFile>\n";
   diefill::write_file_atomic(path, out);
 }
 
-void write_plot_data(const DensityField& f, const FieldStatistics& st, const std::filesystem::path& path) {
+namespace {
+
+double value_or_blank(const DensityField& f, std::size_t n) {
+  const double phi = f.corrected.solid_fraction[n];
+  return f.cavity[n] > 0 && std::isfinite(phi) ? phi : -1.0;
+}
+
+// The voxel row through the field's centre: across the shoe's path (x fixed) or along it (y
+// fixed); the grid puts a voxel centre on the die's axis (grid_covering), so no interpolation.
+nlohmann::json section(const DensityField& f, bool along) {
   const VoxelGrid& g = f.grid;
-  nlohmann::json j;
-  j["voxel_m"] = g.voxel;
-  j["origin_m"] = {g.origin.x(), g.origin.y(), g.origin.z()};
-  j["shape"] = {g.nx, g.ny, g.nz};
-  j["material_density"] = f.material_density;
-  // Top view: each column's solid volume over its cavity volume (the fill an x-ray would see).
-  nlohmann::json top = nlohmann::json::array(), outline = nlohmann::json::array();
-  for (int i = 0; i < g.nx; ++i) {
-    nlohmann::json row = nlohmann::json::array(), cav = nlohmann::json::array();
-    for (int jj = 0; jj < g.ny; ++jj) {
-      double solid = 0, cavity = 0;
-      for (int k = 0; k < g.nz; ++k) solid += f.solid[g.index(i, jj, k)], cavity += f.cavity[g.index(i, jj, k)];
-      row.push_back(cavity > 0 ? solid / (cavity * g.voxel_volume()) : -1.0);
-      cav.push_back(cavity);
+  const int axis = along ? 1 : 0;
+  const int at = std::clamp(int(std::lround((f.centre[axis] - g.origin[axis]) / g.voxel - 0.5)), 0, (along ? g.ny : g.nx) - 1);
+  const int across = along ? g.nx : g.ny;
+  nlohmann::json values = nlohmann::json::array(), merged = nlohmann::json::array(), cavity = nlohmann::json::array();
+  for (int u = 0; u < across; ++u) {
+    nlohmann::json column = nlohmann::json::array(), flags = nlohmann::json::array(), fractions = nlohmann::json::array();
+    for (int k = 0; k < g.nz; ++k) {
+      const std::size_t n = along ? g.index(u, at, k) : g.index(at, u, k);
+      column.push_back(value_or_blank(f, n));
+      flags.push_back(int(f.corrected.merged[n]));
+      fractions.push_back(f.cavity[n]);
     }
-    top.push_back(row);
-    outline.push_back(cav);
+    values.push_back(column), merged.push_back(flags), cavity.push_back(fractions);
+  }
+  const int u_axis = along ? 0 : 1;
+  return {{"at_m", g.origin[axis] + (at + 0.5) * g.voxel},
+          {"extent_m", {g.origin[u_axis], g.origin[u_axis] + across * g.voxel, g.origin.z(), g.origin.z() + g.nz * g.voxel}},
+          {"values", values},
+          {"merged", merged},
+          {"cavity_fraction", cavity}};
+}
+
+nlohmann::json sections(const DensityField& f) { return {{"along", section(f, true)}, {"across", section(f, false)}}; }
+
+// Each column's cavity-weighted mean of the wall-corrected field (the fill an x-ray would see,
+// with the wall's slivers carrying their merged values, as in the sections), and whether most of
+// its cavity holds merged voxels.
+void top_view(const DensityField& f, nlohmann::json& j) {
+  const VoxelGrid& g = f.grid;
+  nlohmann::json top = nlohmann::json::array(), merged = nlohmann::json::array(), cavity = nlohmann::json::array();
+  for (int i = 0; i < g.nx; ++i) {
+    nlohmann::json row = nlohmann::json::array(), flags = nlohmann::json::array(), column_cavity = nlohmann::json::array();
+    for (int jj = 0; jj < g.ny; ++jj) {
+      double sum = 0, weight = 0, merged_weight = 0;
+      for (int k = 0; k < g.nz; ++k) {
+        const std::size_t n = g.index(i, jj, k);
+        const double phi = f.corrected.solid_fraction[n];
+        if (f.cavity[n] <= 0 || !std::isfinite(phi)) continue;
+        sum += f.cavity[n] * phi, weight += f.cavity[n];
+        if (f.corrected.merged[n]) merged_weight += f.cavity[n];
+      }
+      row.push_back(weight > 0 ? sum / weight : -1.0);
+      flags.push_back(int(weight > 0 && merged_weight > 0.5 * weight));
+      column_cavity.push_back(weight);
+    }
+    top.push_back(row), merged.push_back(flags), cavity.push_back(column_cavity);
   }
   j["top_view"] = top;
-  j["top_cavity_voxels"] = outline;
-  // Vertical section through the middle of y.
-  nlohmann::json section = nlohmann::json::array();
-  const int mid = g.ny / 2;
-  for (int i = 0; i < g.nx; ++i) {
-    nlohmann::json col = nlohmann::json::array();
-    for (int k = 0; k < g.nz; ++k) {
-      const std::size_t n = g.index(i, mid, k);
-      const double phi = f.corrected.solid_fraction[n];
-      col.push_back(f.cavity[n] > 0 && std::isfinite(phi) ? phi : -1.0);
+  j["top_merged"] = merged;
+  j["top_cavity_voxels"] = cavity;
+}
+
+// The colour scale from the cavity's own values: the 1st to the 99th cavity-weighted percentile
+// of the voxels the wall correction kept whole (merged slivers and empty corners would stretch it).
+std::array<double, 2> colour_range(const DensityField& f) {
+  std::vector<std::pair<double, double>> samples;
+  double total = 0;
+  for (std::size_t n = 0; n < f.grid.size(); ++n)
+    if (f.cavity[n] > 0 && !f.corrected.merged[n] && std::isfinite(f.corrected.solid_fraction[n])) {
+      samples.emplace_back(f.corrected.solid_fraction[n], f.cavity[n]);
+      total += f.cavity[n];
     }
-    section.push_back(col);
+  if (samples.empty()) return {0.0, 1.0};
+  std::sort(samples.begin(), samples.end());
+  const auto percentile = [&](double p) {
+    double acc = 0;
+    for (const auto& [value, weight] : samples)
+      if ((acc += weight) >= p * total) return value;
+    return samples.back().first;
+  };
+  return {percentile(0.01), percentile(0.99)};
+}
+
+nlohmann::json grid_json(const VoxelGrid& g) {
+  return {{"voxel_m", g.voxel}, {"origin_m", {g.origin.x(), g.origin.y(), g.origin.z()}}, {"shape", {g.nx, g.ny, g.nz}}};
+}
+
+}  // namespace
+
+namespace {
+nlohmann::json profiles_json(const FieldStatistics& st) {
+  nlohmann::json j;
+  for (const Profile& p : st.profiles)
+    j[p.axis] = {{"position_m", p.position}, {"solid_fraction", p.solid_fraction}, {"spread", p.spread}};
+  return j;
+}
+}  // namespace
+
+void write_plot_data(const DensityField& f, const FieldStatistics& st, const DensityField* smoothed,
+                     const FieldStatistics* smoothed_stats, const Outlines& outlines, const std::filesystem::path& path) {
+  const VoxelGrid& g = f.grid;
+  nlohmann::json j = grid_json(g);
+  j["centre_m"] = {f.centre.x(), f.centre.y()};
+  j["material_density"] = f.material_density;
+  j["colour_range"] = colour_range(f);
+  top_view(f, j);
+  j["sections"] = sections(f);
+  if (smoothed) {
+    j["smoothed"] = grid_json(smoothed->grid);
+    j["smoothed"]["sections"] = sections(*smoothed);
+    j["smoothed"]["width_m"] = std::stod(smoothed->metadata.at("width_m"));
+    if (smoothed_stats) j["smoothed"]["profiles"] = profiles_json(*smoothed_stats);
   }
-  j["section_y_m"] = g.origin.y() + (mid + 0.5) * g.voxel;
-  j["section"] = section;
+  j["outline"] = {{"top", outlines.top}, {"along", outlines.along}, {"across", outlines.across}};
   nlohmann::json values = nlohmann::json::array(), weights = nlohmann::json::array();
   for (std::size_t n = 0; n < g.size(); ++n)
     if (f.cavity[n] > 0 && std::isfinite(f.corrected.solid_fraction[n])) {
@@ -135,7 +230,7 @@ void write_plot_data(const DensityField& f, const FieldStatistics& st, const std
   j["histogram_values"] = values;
   j["histogram_weights"] = weights;
   j["mean"] = st.mean;
-  for (const Profile& p : st.profiles) j["profiles"][p.axis] = {{"position_m", p.position}, {"solid_fraction", p.solid_fraction}};
+  j["profiles"] = profiles_json(st);
   diefill::write_file_atomic(path, j.dump());
 }
 

@@ -1,5 +1,6 @@
 #pragma once
 // A density field with its statistics and exports (OpenVDB, VTK image, plot data).
+#include <array>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -9,20 +10,34 @@
 
 namespace post {
 
+// A part of the cavity the report gives statistics for: each voxel's share in it (0..1).
+struct Region {
+  std::string name;
+  std::vector<double> share;
+};
+
 struct DensityField {
   VoxelGrid grid;
-  std::vector<double> solid;           // [m³] solid volume per voxel
+  Vec3 centre = Vec3::Zero();          // [m] the die's axis (x, y): the sections pass through it
+  std::vector<double> solid;           // [m³] solid volume per voxel (the kernel's, when smoothed)
   std::vector<double> cavity;          // cavity fraction per voxel, 0..1
   CorrectedField corrected;            // solid fraction per voxel
+  double min_cavity = 0.25;            // the wall correction's threshold (and the profiles')
   double material_density = 0;         // [kg/m³]
   std::map<std::string, std::string> metadata;  // written into density.vdb
 };
 
 struct Profile {
-  std::string axis;              // "z", "r" or "x"
-  std::vector<double> position;  // [m] bin centres
-  std::vector<double> solid_fraction;  // cavity-volume-weighted mean in the bin
+  std::string axis;                    // "z", "r" or "x"
+  std::vector<double> position;        // [m] bin centres
+  std::vector<double> solid_fraction;  // cavity-weighted mean of its voxels' wall-corrected values
+  std::vector<double> spread;          // cavity-weighted standard deviation of its voxels
   std::vector<double> cavity_volume;   // [m³] in the bin
+};
+
+struct RegionStatistics {
+  std::string name;
+  double cavity_volume_m3 = 0, solid_volume_m3 = 0, fill_ratio = 0;
 };
 
 struct FieldStatistics {
@@ -31,18 +46,35 @@ struct FieldStatistics {
   std::map<int, double> percentiles;  // 5, 25, 50, 75, 95: cavity-volume-weighted
   std::size_t voxels = 0, merged_voxels = 0;
   std::vector<Profile> profiles;
+  std::vector<RegionStatistics> regions;  // filled by the caller, who knows the walls (region_statistics)
 };
 
 // Statistics over the voxels inside the cavity, weighted by their cavity volume; profiles over
-// height, over the radius about `axis_xy` and along x (the shoe's path), in `bins` bins.
-FieldStatistics statistics(const DensityField& field, const Vec3& axis_xy, int bins);
+// height, over the radius about the field's centre and along x (the shoe's path) in bins one
+// voxel wide, leaving out bins with less cavity than the wall correction's threshold.
+FieldStatistics statistics(const DensityField& field);
 
-// density.vdb: FloatGrids solid_fraction, density [kg/m³], cavity_fraction in world metres, with
-// the field's metadata; written atomically.
-void write_vdb(const DensityField& field, const std::filesystem::path& path);
-// density.vti: the same grids as VTK image cell data, for ParaView.
+// Each region's cavity and solid volume on `grid`, from exactly binned `solid` [m³] and the
+// cavity fractions, and their ratio.
+std::vector<RegionStatistics> region_statistics(const VoxelGrid& grid, const std::vector<double>& solid,
+                                                const std::vector<double>& cavity, const std::vector<Region>& regions);
+
+// The die's outline where the views cut it: the opening seen from above (x, y), the section
+// along the shoe's path (x, z at the centre's y) and across it (y, z at the centre's x) [m].
+struct Outlines {
+  std::vector<std::array<double, 4>> top, along, across;
+};
+
+// density.vdb: FloatGrids solid_fraction, density [kg/m³], cavity_fraction and merged (1 where
+// the wall correction pooled the voxel with a neighbour) in world metres, with the field's
+// metadata; with a smoothed field, its grids beside them as smoothed_solid_fraction,
+// smoothed_density and smoothed_cavity_fraction on their own transform. Written atomically.
+void write_vdb(const DensityField& field, const DensityField* smoothed, const std::filesystem::path& path);
+// A field's grids as VTK image cell data, for ParaView.
 void write_vti(const DensityField& field, const std::filesystem::path& path);
-// plot_data.json: the arrays plots.py draws (top view, section, histogram, profiles).
-void write_plot_data(const DensityField& field, const FieldStatistics& stats, const std::filesystem::path& path);
+// plot_data.json: the arrays plots.py draws (top view, sections, histogram, profiles, outlines).
+void write_plot_data(const DensityField& field, const FieldStatistics& stats, const DensityField* smoothed,
+                     const FieldStatistics* smoothed_stats,
+                     const Outlines& outlines, const std::filesystem::path& path);
 
 }  // namespace post

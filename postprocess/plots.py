@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Pictures diefill draws from the data it writes.
 
-    plots.py density OUT_DIR  ->  OUT_DIR/top_view.png, section.png, histogram.png, profiles.png
+    plots.py density OUT_DIR  ->  OUT_DIR/top_view.png, sections.png, histogram.png, profiles.png
                                   (from OUT_DIR/plot_data.json)
     plots.py clump NAME_errors.csv  ->  NAME_errors.png: a clump's errors and cost against its
                                         sphere count
@@ -19,46 +19,104 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.collections import LineCollection  # noqa: E402
 import numpy as np  # noqa: E402
+
+
+MERGED = "x: value merged with a neighbour by the wall correction"
+
+
+def _mm(metres: float) -> str:
+    """A coordinate in mm to 0.01, without a minus sign on zero."""
+    return f"{round(metres * 1e3, 2) + 0.0:.2f}"
+
+
+def _outline(ax, segments) -> None:
+    """The die's outline where the view cuts it (segments u0, v0, u1, v1 in metres)."""
+    if segments:
+        lines = np.array(segments, dtype=float).reshape(-1, 2, 2) * 1e3
+        ax.add_collection(LineCollection(lines, colors="black", linewidths=1.2))
+
+
+def _crop_to(ax, values, extent_mm, shape) -> None:
+    """Axes limits on the cavity's voxels (one voxel of margin): nothing below the floor."""
+    inside = np.argwhere(values >= 0)
+    if inside.size == 0:
+        return
+    u0, u1, v0, v1 = extent_mm
+    du, dv = (u1 - u0) / shape[0], (v1 - v0) / shape[1]
+    (i0, k0), (i1, k1) = inside.min(axis=0), inside.max(axis=0)
+    ax.set_xlim(u0 + (i0 - 0.5) * du, u0 + (i1 + 1.5) * du)
+    ax.set_ylim(v0 + (k0 - 0.5) * dv, v0 + (k1 + 1.5) * dv)
+
+
+def _merged(ax, flags, extent_mm) -> None:
+    """Voxels (or columns) whose value comes from the wall correction's merge: a small cross."""
+    flags = np.array(flags, dtype=float)
+    where = np.argwhere(flags > 0)
+    if where.size == 0:
+        return
+    u0, u1, v0, v1 = extent_mm
+    du, dv = (u1 - u0) / flags.shape[0], (v1 - v0) / flags.shape[1]
+    ax.plot(u0 + (where[:, 0] + 0.5) * du, v0 + (where[:, 1] + 0.5) * dv, "x", color="white", markersize=4)
+
+
+def _section(ax, section, outline, lo, hi, xlabel, title):
+    """A vertical section of the field with the die's outline, cropped to the cavity."""
+    values = np.array(section["values"], dtype=float)
+    extent = [c * 1e3 for c in section["extent_m"]]
+    im = ax.imshow(np.ma.masked_less(values, 0).T, origin="lower", extent=extent, cmap="viridis", vmin=lo, vmax=hi,
+                   interpolation="nearest", aspect="equal")
+    _outline(ax, outline)
+    _crop_to(ax, values, extent, values.shape)
+    if "merged" in section:
+        _merged(ax, section["merged"], extent)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("z [mm]")
+    ax.set_title(title, fontsize="small")
+    return im
 
 
 def density(out_dir: Path) -> None:
     data = json.loads((out_dir / "plot_data.json").read_text())
     h_mm = data["voxel_m"] * 1e3
-    ox, oy, oz = (c * 1e3 for c in data["origin_m"])
-    nx, ny, nz = data["shape"]
+    ox, oy, _ = (c * 1e3 for c in data["origin_m"])
+    nx, ny, _ = data["shape"]
     extent_xy = [ox, ox + nx * h_mm, oy, oy + ny * h_mm]
+    lo, hi = data["colour_range"]
+    outline = data["outline"]
 
-    top = np.array(data["top_view"], dtype=float).T
-    cavity = np.array(data["top_cavity_voxels"], dtype=float).T
-    top = np.ma.masked_less(top, 0)
-    values = np.array(data["histogram_values"], dtype=float)
-    lo, hi = (np.percentile(values, 1), np.percentile(values, 99)) if values.size else (0, 1)
-
-    fig, ax = plt.subplots(figsize=(6, 5))
-    im = ax.imshow(top, origin="lower", extent=extent_xy, cmap="viridis", vmin=lo, vmax=hi, interpolation="nearest")
-    ax.contour(np.linspace(ox + h_mm / 2, ox + (nx - 0.5) * h_mm, nx), np.linspace(oy + h_mm / 2, oy + (ny - 0.5) * h_mm, ny),
-               cavity / max(cavity.max(), 1e-12), levels=[0.5], colors="white", linewidths=1.0)
-    ax.set_xlabel("x [mm] (shoe travel)")
+    top = np.array(data["top_view"], dtype=float)
+    fig, ax = plt.subplots(figsize=(6.4, 5.4))
+    im = ax.imshow(np.ma.masked_less(top, 0).T, origin="lower", extent=extent_xy, cmap="viridis", vmin=lo, vmax=hi,
+                   interpolation="nearest")
+    _outline(ax, outline["top"])
+    _crop_to(ax, top, extent_xy, top.shape)
+    _merged(ax, data["top_merged"], extent_xy)
+    ax.set_xlabel("x [mm]    shoe travel \u2192 (+x)")
     ax.set_ylabel("y [mm]")
-    ax.set_title("Fill density, column average (top view)")
-    fig.colorbar(im, ax=ax, label="solid fraction [-]")
+    ax.set_title(f"Fill density, column average of the wall-corrected field\n{MERGED}", fontsize="small")
+    fig.colorbar(im, ax=ax, label="solid fraction [-]", extend="both")
     fig.tight_layout()
     fig.savefig(out_dir / "top_view.png", dpi=120)
     plt.close(fig)
 
-    section = np.ma.masked_less(np.array(data["section"], dtype=float).T, 0)
-    fig, ax = plt.subplots(figsize=(6, 4))
-    im = ax.imshow(section, origin="lower", extent=[ox, ox + nx * h_mm, oz, oz + nz * h_mm], cmap="viridis",
-                   vmin=lo, vmax=hi, interpolation="nearest", aspect="equal")
-    ax.set_xlabel("x [mm]")
-    ax.set_ylabel("z [mm]")
-    ax.set_title(f"Vertical section at y = {data['section_y_m'] * 1e3:.2f} mm")
-    fig.colorbar(im, ax=ax, label="solid fraction [-]")
-    fig.tight_layout()
-    fig.savefig(out_dir / "section.png", dpi=120)
+    rows = [("", data["sections"], h_mm)]
+    if "smoothed" in data:
+        rows.append(("smoothed ", data["smoothed"]["sections"], data["smoothed"]["width_m"] * 1e3))
+    fig, axes = plt.subplots(len(rows), 2, figsize=(11, 3.6 * len(rows)), squeeze=False)
+    for row, (kind, sections, size_mm) in zip(axes, rows):
+        along, across = sections["along"], sections["across"]
+        what = f"smoothed: Gaussian width and voxel {size_mm:.2g} mm" if kind else f"{size_mm:.2g} mm voxels, exact"
+        im = _section(row[0], along, outline["along"], lo, hi, "x [mm]    shoe travel \u2192 (+x)",
+                      f"Along the shoe's path, y = {_mm(along['at_m'])} mm\n{what}")
+        _section(row[1], across, outline["across"], lo, hi, "y [mm]", f"Across it, x = {_mm(across['at_m'])} mm\n{what}")
+        fig.colorbar(im, ax=row.tolist(), label="solid fraction [-]", extend="both", shrink=0.9)
+    fig.suptitle(f"Sections through the die's centre ({MERGED})", fontsize="medium")
+    fig.savefig(out_dir / "sections.png", dpi=120, bbox_inches="tight")
     plt.close(fig)
 
+    values = np.array(data["histogram_values"], dtype=float)
     fig, ax = plt.subplots(figsize=(6, 4))
     if values.size:
         ax.hist(values, bins=40, weights=np.array(data["histogram_weights"]), color="tab:blue")
@@ -72,15 +130,23 @@ def density(out_dir: Path) -> None:
     plt.close(fig)
 
     profiles = data.get("profiles", {})
-    fig, axes = plt.subplots(1, 3, figsize=(12, 3.6))
+    smoothed = data.get("smoothed", {}).get("profiles", {})
+    fig, axes = plt.subplots(1, 3, figsize=(12, 3.8))
     for ax, (axis, label) in zip(axes, [("z", "height z [mm]"), ("r", "radius from the die axis [mm]"), ("x", "x along the shoe path [mm]")]):
-        if axis in profiles:
+        if axis in profiles and profiles[axis]["position_m"]:
             p = profiles[axis]
-            ax.plot(np.array(p["position_m"]) * 1e3, p["solid_fraction"], marker="o", markersize=3)
+            ax.errorbar(np.array(p["position_m"]) * 1e3, p["solid_fraction"], yerr=p["spread"], marker="o", markersize=3,
+                        capsize=3, linestyle="none", label=f"{h_mm:.2g} mm bins (bars: spread of their voxels)")
+        if axis in smoothed and smoothed[axis]["position_m"]:
+            p = smoothed[axis]
+            ax.plot(np.array(p["position_m"]) * 1e3, p["solid_fraction"], color="tab:orange", linewidth=1.2,
+                    label=f"smoothed field, {data['smoothed']['width_m'] * 1e3:.2g} mm bins")
+        if ax.has_data():
+            ax.legend(fontsize="x-small")
         ax.set_xlabel(label)
         ax.set_ylabel("solid fraction [-]")
         ax.grid(alpha=0.3)
-    fig.suptitle("Fill density profiles")
+    fig.suptitle("Fill density profiles (bins one voxel wide; bins mostly outside the cavity left out)")
     fig.tight_layout()
     fig.savefig(out_dir / "profiles.png", dpi=120)
     plt.close(fig)

@@ -116,8 +116,12 @@ KeyTable<P> make_pipeline_keys() {
   k.push_back(number("density", "voxel", "m", {0, metre_range_hi}, run, "0: two grain diameters", &P::density_voxel));
   k.push_back(text("density", "method", KeyType::choice, {"exact", "gaussian"}, run,
                    "exact volume split, or Gaussian coarse graining", &P::density_method));
+  k.push_back(number("density", "smoothed_width", "m", {0, metre_range_hi}, run,
+                     "the smoothed field's Gaussian width and voxel; 0: half a grain diameter", &P::density_smoothed_width));
   k.push_back(text("output", "directory", KeyType::text, {}, nothing, "each die writes into DIRECTORY/<die name>/ (relative "
                    "to the working folder)", &P::out));
+  k.push_back(text("output", "cache", KeyType::text, {}, nothing, "prepared die fields and settled shoes, reused by runs "
+                   "that share them; empty: DIRECTORY/.cache", &P::cache));
   k.push_back(number("output", "snapshot_every", "s", {0, 100}, nothing, "VTU snapshots; 0: the final state only",
                      &P::snapshot_every));
   k.push_back(number("output", "fill_curve_every", "s", {0, 1, true}, nothing,

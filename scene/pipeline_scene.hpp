@@ -49,8 +49,10 @@ struct PipelineScene {
   // [density]
   double density_voxel = 0;           // [m]; 0: two grain diameters
   std::string density_method = "exact";
+  double density_smoothed_width = 0;  // [m]; 0: half a grain diameter
   // [output]
   std::filesystem::path out = "out";
+  std::filesystem::path cache;        // empty: out / ".cache"
   double snapshot_every = 0;          // [s]; 0: final snapshot only
   double fill_curve_every = 0.002;    // [s]
 

@@ -43,7 +43,8 @@ double ring_core_solid_fraction(const dem::State& s, double margin, double voxel
   std::vector<post::Grain> grains;
   for (std::size_t i = 0; i < s.size(); ++i) grains.push_back({s.x[i], s.radius[i], 1.0});
   const post::VoxelGrid grid = post::grid_covering(Vec3(-ring_outer_radius, -ring_outer_radius, -ring_depth),
-                                                   Vec3(ring_outer_radius, ring_outer_radius, 0), voxel, 0.0);
+                                                   Vec3(ring_outer_radius, ring_outer_radius, 0), voxel,
+                                                   Vec3(voxel / 2, voxel / 2, 0));
   std::vector<double> solid;
   post::bin_exact(grains, grid, solid);
   double core_solid = 0, core_volume = 0;

@@ -18,7 +18,7 @@ if [[ "$data" != "$tmp/moved/share/diefill"* ]]; then
 fi
 "$tmp/moved/bin/diefill" run "$tmp/ring.stl" --out "$tmp/out" --set powder.coarse_graining=16 \
   --set motion.speed=0.4 --set motion.die_settle_time=0.01
-for file in report.json density.vdb top_view.png section.png histogram.png; do
+for file in report.json density.vdb top_view.png sections.png histogram.png; do
   [[ -s "$tmp/out/ring/$file" ]] || { echo "install_test: $file is missing" >&2; exit 1; }
 done
 echo "install_test: passed"

@@ -167,7 +167,7 @@ TEST(CliDensity, WritesAFieldThatOpenVdbReadsBack) {
   const test::Run run = test::run_diefill("density " + (dir / "grains.csv").string() + " --die " +
                                           (test::source_dir() / "dies" / "disc.stl").string() + " --voxel 1 --coarse-graining 8 -o " + out);
   ASSERT_EQ(run.status, 0) << run.output;
-  for (const char* file : {"density.vdb", "density.vti", "density.json", "top_view.png", "section.png", "histogram.png"})
+  for (const char* file : {"density.vdb", "density.vti", "density.json", "top_view.png", "sections.png", "histogram.png"})
     EXPECT_TRUE(std::filesystem::exists(dir / "field" / file)) << file;
   // An independent reader: OpenVDB's Python module recomputes the cavity-weighted mean.
   test::write_text(dir / "check.py", R"(
