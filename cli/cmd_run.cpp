@@ -8,7 +8,9 @@
 
 #include "cli/commands.hpp"
 #include "cli/mpi_session.hpp"
+#include "pipeline/compare.hpp"
 #include "pipeline/die_fill.hpp"
+#include "pipeline/sweep.hpp"
 #include "pipeline/run_loop.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
@@ -72,6 +74,21 @@ int run_pipeline(const RunCommand& c) {
   // Under mpirun every rank runs this; rank 0 reports (pipeline/die_fill.hpp).
   const std::shared_ptr<dem::Exchange> ranks = mpi_exchange();
   const bool root = !ranks || ranks->rank() == 0;
+  if (c.sweep) {
+    if (fs::is_directory(c.target))
+      throw diefill::InputError(c.target.string(), "--sweep", "sweeps one die, not a folder", "Give a die mesh or a scene");
+    const auto load = [&](const std::vector<std::string>& more) {
+      std::vector<std::string> overrides = c.overrides;
+      overrides.insert(overrides.end(), more.begin(), more.end());
+      PipelineScene scene = scene_for(c.target, overrides);
+      apply_command_line(scene, c);
+      return scene;
+    };
+    const std::vector<DieRun> runs = run_sweep(load, parse_sweep(*c.sweep), ranks);
+    if (!runs.empty() && runs.back().interrupted) return diefill::exit_interrupted;
+    if (root) fmt::print("sweep: {} runs; summary {}\n", runs.size(), (runs.front().dir.parent_path().parent_path() / "sweep.csv").string());
+    return 0;
+  }
   if (!fs::is_directory(c.target)) {
     PipelineScene scene = scene_for(c.target, c.overrides);
     apply_command_line(scene, c);
@@ -126,6 +143,15 @@ int run_pipeline(const RunCommand& c) {
     fmt::print("{}", md);
   }
   return unstable > 0 ? diefill::exit_unstable : refused > 0 ? diefill::exit_bad_input : diefill::exit_ok;
+}
+
+int run_compare(const CompareCommand& c) {
+  const nlohmann::json summary = compare_runs(c.run_a, c.run_b, c.out);
+  fmt::print("fill ratio {:.4f} (A) against {:.4f} (B): B - A = {:+.4f}; per voxel RMS difference {:.4f} over {} voxels -> {}\n",
+             summary["fill"]["fill_ratio"]["a"].get<double>(), summary["fill"]["fill_ratio"]["b"].get<double>(),
+             summary["fill"]["fill_ratio"]["difference"].get<double>(), summary["field"]["rms_difference"].get<double>(),
+             summary["field"]["voxels"].get<std::size_t>(), c.out.string());
+  return 0;
 }
 
 }  // namespace app

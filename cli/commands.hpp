@@ -37,8 +37,15 @@ struct RunCommand {
   std::optional<std::string> up;     // die.up
   std::optional<std::string> units;  // die.units
   bool resume = false;
+  std::optional<std::string> sweep;  // KEY=V1,V2,...: one run per value (pipeline/sweep.hpp)
 };
 int run_pipeline(const RunCommand& command);
+
+struct CompareCommand {
+  std::filesystem::path run_a, run_b;
+  std::filesystem::path out = "out/compare";
+};
+int run_compare(const CompareCommand& command);
 
 struct SceneCommand {
   std::filesystem::path target;

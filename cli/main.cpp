@@ -40,6 +40,9 @@ void add_run(CLI::App& root, app::RunCommand& c, std::function<int()>& action) {
   cmd->add_option("--up", c.up, "The way the die's opening faces in its file: +x, -x, +y, -y, +z, -z or auto (die.up)");
   cmd->add_option("--units", c.units, "Length unit of the die's file: mm, m or in (die.units)");
   cmd->add_flag("--resume", c.resume, "Continue an interrupted run from its checkpoint");
+  cmd->add_option("--sweep", c.sweep,
+                  "Run once per value of a scene key, each into OUT/KEY=VALUE/, with a summary table and chart: "
+                  "--sweep motion.speed=0.05,0.1,0.2");
   cmd->callback([&] { action = [&] { return app::run_pipeline(c); }; });
 }
 
@@ -92,6 +95,14 @@ void add_density(CLI::App& root, app::DensityCommand& c, std::function<int()>& a
       ->capture_default_str()
       ->check(CLI::Range(1.0, 1e4));
   cmd->callback([&] { action = [&] { return app::run_density(c); }; });
+}
+
+void add_compare(CLI::App& root, app::CompareCommand& c, std::function<int()>& action) {
+  CLI::App* cmd = root.add_subcommand("compare", "Two runs of one die side by side: fill statistics and the density difference");
+  cmd->add_option("RUN_A", c.run_a, "A run's output folder (OUT/<die name>/)")->required();
+  cmd->add_option("RUN_B", c.run_b, "The other run's folder; differences are B - A")->required();
+  cmd->add_option("-o,--output", c.out, "Output folder: compare.json, difference.vdb, compare.png")->capture_default_str();
+  cmd->callback([&] { action = [&] { return app::run_compare(c); }; });
 }
 
 void add_die(CLI::App& root, app::DieCommand& c, std::function<int()>& action) {
@@ -157,6 +168,8 @@ int main(int argc, char** argv) {
   add_density(root, density, action);
   add_sdf(root, sdf, action);
   add_die(root, die, action);
+  app::CompareCommand compare;
+  add_compare(root, compare, action);
   app::ClumpCommand clump;
   add_clump(root, clump, action);
   app::study::StudyRequest study;

@@ -5,6 +5,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "mesh/exact.hpp"
 #include "pipeline/pictures.hpp"
 
 namespace app {
@@ -125,9 +126,11 @@ DensityResult compute_density(const std::vector<post::Grain>& grains, const mesh
   const post::DensityField& fine = r.smoothed ? *r.smoothed : r.field;
   std::vector<double> fine_solid;
   post::bin_exact(grains, fine.grid, fine_solid);
-  r.stats.regions = post::region_statistics(
-      fine.grid, fine_solid, fine.cavity,
-      fill_regions(fine.grid, c.centre, c.lo.z(), c.hi.z(), 2 * largest_radius, [&](const post::Vec3& p) { return walls.signed_distance(p); }));
+  // The wall field's distance saturates a little beyond a grain radius; Embree's is exact.
+  const mesh::ExactSurface tool(die.solid);
+  const auto distance_to_wall = [&](const post::Vec3& p) { return walls.signed_distance(p) < 0 ? -1.0 : tool.distance(p); };
+  r.stats.regions = post::region_statistics(fine.grid, fine_solid, fine.cavity,
+                                            fill_regions(fine.grid, c.centre, c.lo.z(), c.hi.z(), 2 * largest_radius, distance_to_wall));
   r.outlines = outlines_of(die.cavity, c, s.voxel_m);
   return r;
 }

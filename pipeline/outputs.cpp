@@ -52,11 +52,14 @@ nlohmann::json write_fill_curve_outputs(const FillRecord& r, const fs::path& dir
           {"curve", "fill_curve.csv"}};
 }
 
-// Of every key that shapes the result (not where it is written, nor how fast) and the materials:
-// runs with equal hashes and seeds are the same scene.
+// Of every key that shapes the result (not where it is written, nor how fast) and the materials,
+// but the seed (run.seed beside it): runs with equal hashes are the same scene, and with equal
+// seeds too the same run (`diefill compare` tells seeds of one scene from different scenes).
 std::string scene_hash(const PipelineScene& s) {
+  PipelineScene unseeded = s;
+  unseeded.seed = 0;
   std::string text;
-  for (const Shapes what : {Shapes::die, Shapes::settling, Shapes::run}) text += shaping_values(pipeline_keys(), what, s);
+  for (const Shapes what : {Shapes::die, Shapes::settling, Shapes::run}) text += shaping_values(pipeline_keys(), what, unseeded);
   return diefill::sha256_hex(text + describe_materials(s.spec));
 }
 

@@ -64,19 +64,73 @@ void add_grids(const DensityField& f, const std::string& prefix, openvdb::GridPt
   }
 }
 
-}  // namespace
-
-void write_vdb(const DensityField& f, const DensityField* smoothed, const std::filesystem::path& path) {
+void initialize_openvdb() {
   static std::once_flag once;
   std::call_once(once, [] { openvdb::initialize(); });
-  openvdb::GridPtrVec grids;
-  add_grids(f, "", grids);
-  if (smoothed) add_grids(*smoothed, "smoothed_", grids);
+}
+
+void write_grids(const openvdb::GridPtrVec& grids, const std::filesystem::path& path) {
   diefill::PendingFile pending(path);
   openvdb::io::File file(pending.path().string());
   file.write(grids);
   file.close();
   pending.commit();
+}
+
+}  // namespace
+
+void write_vdb(const DensityField& f, const DensityField* smoothed, const std::filesystem::path& path) {
+  initialize_openvdb();
+  openvdb::GridPtrVec grids;
+  add_grids(f, "", grids);
+  if (smoothed) add_grids(*smoothed, "smoothed_", grids);
+  write_grids(grids, path);
+}
+
+std::map<std::string, StoredGrid> read_vdb(const std::filesystem::path& path) {
+  initialize_openvdb();
+  std::map<std::string, StoredGrid> out;
+  try {
+    openvdb::io::File file(path.string());
+    file.open();
+    const openvdb::GridPtrVecPtr grids = file.getGrids();  // kept: the loop must not outlive it
+    for (const openvdb::GridBase::Ptr& base : *grids) {
+      const auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
+      if (!grid) continue;
+      StoredGrid& stored = out[grid->getName()];
+      stored.voxel_m = grid->voxelSize()[0];
+      const openvdb::Vec3d first = grid->indexToWorld(openvdb::Coord(0, 0, 0));
+      stored.first_centre = Vec3(first.x(), first.y(), first.z());
+      for (auto meta = grid->beginMeta(); meta != grid->endMeta(); ++meta) stored.metadata[meta->first] = meta->second->str();
+      for (auto on = grid->cbeginValueOn(); on; ++on) {
+        const openvdb::Coord c = on.getCoord();
+        stored.values[{c.x(), c.y(), c.z()}] = double(*on);
+      }
+    }
+    file.close();
+  } catch (const openvdb::Exception& e) {
+    throw diefill::InputError(path.string(), "", std::string("cannot be read as OpenVDB: ") + e.what(),
+                              "Give the density.vdb a diefill run wrote");
+  }
+  return out;
+}
+
+void write_vdb(const std::map<std::string, StoredGrid>& grids, const std::filesystem::path& path) {
+  initialize_openvdb();
+  openvdb::GridPtrVec out;
+  for (const auto& [name, stored] : grids) {
+    auto grid = openvdb::FloatGrid::create(0.0f);
+    grid->setName(name);
+    auto t = openvdb::math::Transform::createLinearTransform(stored.voxel_m);
+    t->postTranslate(openvdb::Vec3d(stored.first_centre.x(), stored.first_centre.y(), stored.first_centre.z()));
+    grid->setTransform(t);
+    grid->setGridClass(openvdb::GRID_FOG_VOLUME);
+    auto acc = grid->getAccessor();
+    for (const auto& [index, value] : stored.values) acc.setValue(openvdb::Coord(index[0], index[1], index[2]), float(value));
+    for (const auto& [key, value] : stored.metadata) grid->insertMeta(key, openvdb::StringMetadata(value));
+    out.push_back(grid);
+  }
+  write_grids(out, path);
 }
 
 void write_vti(const DensityField& f, const std::filesystem::path& path) {

@@ -77,4 +77,17 @@ void write_plot_data(const DensityField& field, const FieldStatistics& stats, co
                      const FieldStatistics* smoothed_stats,
                      const Outlines& outlines, const std::filesystem::path& path);
 
+// One grid of a density.vdb as stored: its voxel edge, the centre of its voxel (0, 0, 0), its
+// metadata, and its active voxels' values by index.
+struct StoredGrid {
+  double voxel_m = 0;
+  Vec3 first_centre = Vec3::Zero();
+  std::map<std::string, std::string> metadata;
+  std::map<std::array<int, 3>, double> values;
+};
+// Every FloatGrid of a .vdb by name; throws InputError naming the file when it cannot be read.
+std::map<std::string, StoredGrid> read_vdb(const std::filesystem::path& path);
+// The grids as FloatGrids of a .vdb (fog volumes, world metres), with each grid's metadata; atomic.
+void write_vdb(const std::map<std::string, StoredGrid>& grids, const std::filesystem::path& path);
+
 }  // namespace post

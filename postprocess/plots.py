@@ -8,6 +8,8 @@
     plots.py study DIR/NAME.json  ->  every chart the study lists under "charts", into DIR
     plots.py fill_curve DIR/fill_curve.csv STRIKE_OFF_S  ->  DIR/fill_curve.png: the mass in the
                                   cavity against time and against the shoe's position
+    plots.py compare DIR  ->  DIR/compare.png (from DIR/compare_plot.json): two runs' difference
+    plots.py sweep DIR/sweep.json  ->  DIR/sweep.png: fill ratio against the swept key
 
 Each picture has axes with units and, where colour carries a value, a colour bar.
 """
@@ -232,8 +234,58 @@ def fill_curve(csv: Path, strike_off_s: float) -> None:
     plt.close(fig)
 
 
+def compare(out_dir: Path) -> None:
+    """Two runs side by side: the top view of B - A and both runs' profiles."""
+    data = json.loads((out_dir / "compare_plot.json").read_text())
+    top = np.ma.masked_less(np.array(data["top_difference"], dtype=float), -1.5)
+    reach = max(float(np.abs(top).max()) if top.count() else 0.0, 1e-6)
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.4))
+    im = axes[0].imshow(top.T, origin="lower", extent=[c * 1e3 for c in data["extent_m"]], cmap="RdBu_r", vmin=-reach,
+                        vmax=reach, interpolation="nearest")
+    fig.colorbar(im, ax=axes[0], label="solid fraction, B - A [-]")
+    axes[0].set_xlabel("x [mm]    shoe travel \u2192 (+x)")
+    axes[0].set_ylabel("y [mm]")
+    axes[0].set_title("Difference, column mean", fontsize="medium")
+    for ax, (axis, label) in zip(axes[1:], [("z", "height z [mm]"), ("r", "radius from the die axis [mm]")]):
+        for run, label_run, colour in zip(("a", "b"), data["labels"], ("tab:blue", "tab:orange")):
+            p = data["profiles"][run].get(axis)
+            if p and p["position_m"]:
+                ax.errorbar(np.array(p["position_m"]) * 1e3, p["solid_fraction"], yerr=p.get("spread"), marker="o",
+                            markersize=3, capsize=3, color=colour, label=label_run)
+        ax.set_xlabel(label)
+        ax.set_ylabel("solid fraction [-]")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize="x-small")
+    fig.suptitle("Two runs compared")
+    fig.tight_layout()
+    fig.savefig(out_dir / "compare.png", dpi=120)
+    plt.close(fig)
+
+
+def sweep(summary: Path) -> None:
+    """Fill ratio against the swept key's value."""
+    data = json.loads(summary.read_text())
+    cases = data["cases"]
+    try:
+        x = [float(c["value"]) for c in cases]
+    except ValueError:  # a key whose values are words: one tick each
+        x = list(range(len(cases)))
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    ax.plot(x, [c["fill_ratio"] for c in cases], "o-")
+    if not all(isinstance(v, float) for v in x):
+        ax.set_xticks(x)
+        ax.set_xticklabels([c["value"] for c in cases])
+    ax.set_xlabel(data["key"])
+    ax.set_ylabel("fill ratio [-]")
+    ax.set_title(f"Fill ratio against {data['key']}")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(summary.with_suffix(".png"), dpi=120)
+    plt.close(fig)
+
+
 if __name__ == "__main__":
     if sys.argv[1] == "fill_curve":
         fill_curve(Path(sys.argv[2]), float(sys.argv[3]))
     else:
-        {"density": density, "clump": clump, "study": study}[sys.argv[1]](Path(sys.argv[2]))
+        {"density": density, "clump": clump, "study": study, "compare": compare, "sweep": sweep}[sys.argv[1]](Path(sys.argv[2]))

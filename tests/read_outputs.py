@@ -33,6 +33,10 @@ for item in cav.citerOnValues():
     weighted += item.value * value * h ** 3
 out["vdb_cavity_volume_m3"] = cavity
 out["vdb_solid_fraction_mean"] = weighted / cavity
+out["vdb_merged_voxels"] = sum(1 for item in g["merged"].citerOnValues() if item.value > 0)
+smoothed = g["smoothed_solid_fraction"]
+out["vdb_smoothed_voxel_m"] = smoothed.transform.voxelSize()[0]
+out["vdb_smoothed_width_m"] = float(smoothed["width_m"])
 
 reader = vtkXMLImageDataReader()
 reader.SetFileName(run + "/density.vti")
@@ -43,6 +47,10 @@ out["vti_spacing_m"] = image.GetSpacing()[0]
 out["vti_arrays"] = sorted(image.GetCellData().GetArrayName(k) for k in range(image.GetCellData().GetNumberOfArrays()))
 values = vtk_to_numpy(image.GetCellData().GetArray("solid_fraction")).reshape(nz, ny, nx)
 out["vti_vdb_max_difference"] = max(abs(float(values[k, j, i]) - v) for (i, j, k), v in vdb_values.items())
+reader = vtkXMLImageDataReader()
+reader.SetFileName(run + "/density_smoothed.vti")
+reader.Update()
+out["smoothed_vti_spacing_m"] = reader.GetOutput().GetSpacing()[0]
 
 grains = meshio.read(run + "/final.vtu")
 rows = list(csv.DictReader(open(run + "/particles.csv")))

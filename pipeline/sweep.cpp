@@ -1,0 +1,62 @@
+#include "pipeline/sweep.hpp"
+
+#include <fmt/core.h>
+
+#include <sstream>
+
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "pipeline/pictures.hpp"
+
+namespace app {
+
+namespace fs = std::filesystem;
+
+Sweep parse_sweep(const std::string& text) {
+  const auto equals = text.find('=');
+  Sweep s;
+  if (equals != std::string::npos) {
+    s.key = text.substr(0, equals);
+    std::stringstream list(text.substr(equals + 1));
+    for (std::string value; std::getline(list, value, ',');)
+      if (!value.empty()) s.values.push_back(value);
+  }
+  if (s.key.empty() || s.values.empty())
+    throw diefill::InputError("--sweep", "", "'" + text + "' is not KEY=VALUE,VALUE,...",
+                              "Give a scene key and its values: --sweep motion.speed=0.05,0.1,0.2");
+  return s;
+}
+
+std::vector<DieRun> run_sweep(const std::function<PipelineScene(const std::vector<std::string>& overrides)>& load,
+                              const Sweep& sweep, const std::shared_ptr<dem::Exchange>& ranks) {
+  std::vector<DieRun> runs;
+  fs::path base;
+  for (const std::string& value : sweep.values) {
+    PipelineScene scene = load({sweep.key + "=" + value});
+    base = scene.out;
+    if (scene.cache.empty()) scene.cache = base / ".cache";  // one settled shoe for every case it fits
+    scene.out = base / (sweep.key + "=" + value);
+    runs.push_back(run_die_fill(scene, scene.die, false, ranks));
+    if (runs.back().interrupted) return runs;
+  }
+  if (ranks && ranks->rank() != 0) return runs;
+  std::string csv = fmt::format("{},fill_ratio,mass_kg,grains_in_cavity,lost,final_state_sha256,folder\n", sweep.key);
+  nlohmann::json cases = nlohmann::json::array();
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const nlohmann::json& r = runs[k].report;
+    csv += fmt::format("{},{:.9g},{:.9g},{},{},{},{}\n", sweep.values[k], r["fill"]["fill_ratio"].get<double>(),
+                       r["fill"]["mass_kg"].get<double>(), r["particles"]["in_cavity"].get<std::int64_t>(),
+                       r["particles"]["lost"].get<std::int64_t>(), r["final_state_sha256"].get<std::string>(), runs[k].dir.string());
+    cases.push_back({{"value", sweep.values[k]},
+                     {"fill_ratio", r["fill"]["fill_ratio"]},
+                     {"mass_kg", r["fill"]["mass_kg"]},
+                     {"grains_in_cavity", r["particles"]["in_cavity"]},
+                     {"folder", runs[k].dir.string()}});
+  }
+  diefill::write_file_atomic(base / "sweep.csv", csv);
+  diefill::write_file_atomic(base / "sweep.json", nlohmann::json({{"key", sweep.key}, {"cases", cases}}).dump(2) + "\n");
+  draw_pictures({"sweep", (base / "sweep.json").string()});
+  return runs;
+}
+
+}  // namespace app
