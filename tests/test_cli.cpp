@@ -198,7 +198,7 @@ print(json.dumps({"names": names, "voxel": phi.transform.voxelSize()[0], "units"
   while (std::size_t n = std::fread(buffer, 1, sizeof buffer, pipe)) text.append(buffer, n);
   ASSERT_EQ(::pclose(pipe), 0) << text;
   const auto j = nlohmann::json::parse(text);
-  EXPECT_EQ(j["names"], nlohmann::json({"cavity_fraction", "density", "solid_fraction"}));
+  EXPECT_EQ(j["names"], nlohmann::json({"cavity_fraction", "density", "merged", "solid_fraction"}));
   EXPECT_DOUBLE_EQ(j["voxel"].get<double>(), 1e-3);
   EXPECT_EQ(j["units"], "m");
   EXPECT_EQ(j["coarse_graining"], "8");  // as the pipeline's field records it
@@ -207,7 +207,7 @@ print(json.dumps({"names": names, "voxel": phi.transform.voxelSize()[0], "units"
   EXPECT_DOUBLE_EQ(j["material_density"].get<double>(), 7800);
   EXPECT_NEAR(j["mean"].get<double>(), j["report_mean"].get<double>(), 1e-6);
   EXPECT_LT(j["density_error"].get<double>(), 1e-2);
-  // vdb_print, Debian's command-line reader, lists the three grids.
+  // vdb_print, Debian's command-line reader, lists the grids.
   FILE* p2 = ::popen(("vdb_print " + out + "/density.vdb 2>&1").c_str(), "r");
   std::string printed;
   while (std::size_t n = std::fread(buffer, 1, sizeof buffer, p2)) printed.append(buffer, n);
@@ -228,6 +228,23 @@ TEST(CliDensity, BadInputLeavesNoPartialOutput) {
   expect_refused("id,x,y,z,vx,vy,vz,wx,wy,wz\n1,0,0,-0.005,0,0,0,0,0,0\n", "column radius", die);
   expect_refused("id,x,y,z,vx,vy,vz,wx,wy,wz,radius\n1,nan,0,-0.005,0,0,0,0,0,0,5e-4\n", "not a finite number", die);
   expect_refused("id,x,y,z,vx,vy,vz,wx,wy,wz,radius,density\n1,0.5,0.5,0.5,0,0,0,0,0,0,1e-3,7800\n", "lies in the cavity", die);
+}
+
+// compare and sweep refuse what they cannot do, naming the folder or the option, and write nothing.
+TEST(CliCompare, RefusesFoldersThatAreNotRunsAndBadSweeps) {
+  test::TempDir dir;
+  std::filesystem::create_directories(dir / "empty");
+  std::filesystem::create_directories(dir / "broken");
+  const std::string out = " -o " + (dir / "compared").string();
+  expect_bad_input("compare " + (dir / "empty").string() + " " + (dir / "empty").string() + out, "report.json", "not a run's folder");
+  test::write_text(dir / "broken" / "report.json", "{not json");
+  expect_bad_input("compare " + (dir / "broken").string() + " " + (dir / "broken").string() + out, "report.json", "is not JSON");
+  EXPECT_FALSE(std::filesystem::exists(dir / "compared"));
+  expect_bad_input("run " + (test::source_dir() / "dies" / "ring.stl").string() + " --sweep motion.speed --out " + (dir / "swept").string(),
+                   "--sweep", "KEY=VALUE");
+  expect_bad_input("run " + (test::source_dir() / "dies").string() + " --sweep motion.speed=0.1,0.2 --out " + (dir / "swept").string(),
+                   "--sweep", "not a folder");
+  EXPECT_FALSE(std::filesystem::exists(dir / "swept"));
 }
 
 // `diefill sdf -o FILE.vdb` writes the distance grid alone: OpenVDB's own Python module refused
