@@ -42,7 +42,7 @@ int run_density(const DensityCommand& c) {
   s.voxel_m = c.voxel_mm > 0 ? c.voxel_mm * 1e-3 : 4 * r_max;
   s.method = c.method;
   s.width_m = c.width_mm * 1e-3;
-  s.smoothed_width_m = c.smoothed_width_mm * 1e-3;
+  s.smoothed_width_m = c.smoothed_width_mm > 0 ? c.smoothed_width_mm * 1e-3 : r_max;  // as the pipeline: half a diameter
   s.coarse_graining = c.coarse_graining;
   const DensityResult result = compute_density(grains, die, walls, material_density, s, c.particles.string());
   diefill::StagingFolder out(c.output);

@@ -77,6 +77,8 @@ int run_pipeline(const RunCommand& c) {
   if (c.sweep) {
     if (fs::is_directory(c.target))
       throw diefill::InputError(c.target.string(), "--sweep", "sweeps one die, not a folder", "Give a die mesh or a scene");
+    if (c.resume)
+      throw diefill::InputError("--sweep", "--resume", "a sweep does not resume", "Resume the interrupted case with `diefill run` and its --set");
     const auto load = [&](const std::vector<std::string>& more) {
       std::vector<std::string> overrides = c.overrides;
       overrides.insert(overrides.end(), more.begin(), more.end());
@@ -86,7 +88,9 @@ int run_pipeline(const RunCommand& c) {
     };
     const std::vector<DieRun> runs = run_sweep(load, parse_sweep(*c.sweep), ranks);
     if (!runs.empty() && runs.back().interrupted) return diefill::exit_interrupted;
-    if (root) fmt::print("sweep: {} runs; summary {}\n", runs.size(), (runs.front().dir.parent_path().parent_path() / "sweep.csv").string());
+    if (root)
+      fmt::print("sweep: {} runs; summary {}\n", runs.size(),
+                 (runs.front().dir.parent_path().parent_path() / ("sweep_" + parse_sweep(*c.sweep).key + ".csv")).string());
     return 0;
   }
   if (!fs::is_directory(c.target)) {

@@ -43,7 +43,7 @@ int run_pipeline(const RunCommand& command);
 
 struct CompareCommand {
   std::filesystem::path run_a, run_b;
-  std::filesystem::path out = "out/compare";
+  std::filesystem::path out;  // required: a comparison never replaces another's folder unasked
 };
 int run_compare(const CompareCommand& command);
 
@@ -84,7 +84,7 @@ struct DensityCommand {
   double voxel_mm = 0;        // 0: four grain radii
   std::string method = "exact";
   double width_mm = 0;        // Gaussian width (0: one voxel)
-  double smoothed_width_mm = 0;  // > 0: also the smoothed field of this width
+  double smoothed_width_mm = 0;  // the smoothed field's width (0: half the largest grain diameter)
   double material_density = 0;  // 0: from the particle file
   double coarse_graining = 1;    // α of the file's grains over the real powder's (1: they are the powder)
 };

@@ -88,7 +88,8 @@ void add_density(CLI::App& root, app::DensityCommand& c, std::function<int()>& a
   cmd->add_option("--method", c.method, "exact (volume split exactly) or gaussian (kernel)")->capture_default_str();
   cmd->add_option("--width", c.width_mm, "Gaussian width [mm] (default: one voxel)");
   cmd->add_option("--smoothed-width", c.smoothed_width_mm,
-                  "Also write the smoothed field (Gaussian of this width [mm], on voxels as wide) beside the main one");
+                  "Width [mm] of the smoothed field written beside the main one (Gaussian, on voxels as wide; default "
+                  "half the largest grain diameter)");
   cmd->add_option("--material-density", c.material_density, "Grain material density [kg/m³] (default: from the file)");
   cmd->add_option("--coarse-graining", c.coarse_graining,
                   "The file's grains over the real powder's size, recorded in the field (1: they are the powder)")
@@ -101,7 +102,7 @@ void add_compare(CLI::App& root, app::CompareCommand& c, std::function<int()>& a
   CLI::App* cmd = root.add_subcommand("compare", "Two runs of one die side by side: fill statistics and the density difference");
   cmd->add_option("RUN_A", c.run_a, "A run's output folder (OUT/<die name>/)")->required();
   cmd->add_option("RUN_B", c.run_b, "The other run's folder; differences are B - A")->required();
-  cmd->add_option("-o,--output", c.out, "Output folder: compare.json, difference.vdb, compare.png")->capture_default_str();
+  cmd->add_option("-o,--output", c.out, "Output folder: compare.json, difference.vdb, compare.png")->required();
   cmd->callback([&] { action = [&] { return app::run_compare(c); }; });
 }
 

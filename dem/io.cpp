@@ -2,13 +2,16 @@
 
 #include <fmt/core.h>
 
+#include <bit>
 #include <charconv>
+#include <cstring>
 #include <cmath>
 #include <fstream>
 #include <map>
 #include <sstream>
 
 #include "core/atomic_file.hpp"
+#include "core/base64.hpp"
 #include "core/error.hpp"
 
 namespace dem {
@@ -131,40 +134,63 @@ void TrajectoryWriter::write(const State& s) {
                s.w[i].x(), s.w[i].y(), s.w[i].z(), s.f[i].x(), s.f[i].y(), s.f[i].z());
 }
 
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "the VTU's binary arrays are written as the machine holds them");
+
+// A binary DataArray: base64 of a UInt64 byte count and the little-endian values (VTK's XML
+// "binary" format): every value exact, with no text conversion either way. (Base64's 4/3 leaves
+// it only 12 % smaller than nine-digit ASCII, measured on the ring's final state.)
+template <typename T>
+void binary_array(std::string& out, const char* type, const std::string& name, int components, const std::vector<T>& values) {
+  std::vector<std::uint8_t> bytes(sizeof(std::uint64_t) + values.size() * sizeof(T));
+  const std::uint64_t size = values.size() * sizeof(T);
+  std::memcpy(bytes.data(), &size, sizeof size);
+  if (!values.empty()) std::memcpy(bytes.data() + sizeof size, values.data(), size);
+  // Scalars without NumberOfComponents, as VTK writes them (readers such as meshio then give 1-D arrays).
+  const std::string shape = components > 1 ? fmt::format(" NumberOfComponents=\"{}\"", components) : "";
+  out += fmt::format("<DataArray type=\"{}\" Name=\"{}\"{} format=\"binary\">\n", type, name, shape);
+  out += diefill::base64_encode(bytes.data(), bytes.size());
+  out += "\n</DataArray>\n";
+}
+
+std::vector<double> flattened(const Array<Vec3>& a) {
+  std::vector<double> out;
+  out.reserve(3 * a.size());
+  for (const Vec3& v : a) out.insert(out.end(), {v.x(), v.y(), v.z()});
+  return out;
+}
+
+}  // namespace
+
 void write_vtu(const State& s, const fs::path& path) {
   std::string out;
-  out += "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n";
+  out += "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
+         "header_type=\"UInt64\">\n";
   out += fmt::format("<UnstructuredGrid><Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n", s.size(), s.size());
-  auto vectors = [&](const char* name, const Array<Vec3>& a) {
-    out += fmt::format("<DataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"3\" format=\"ascii\">\n", name);
-    for (const Vec3& v : a) out += fmt::format("{:.9g} {:.9g} {:.9g}\n", v.x(), v.y(), v.z());
-    out += "</DataArray>\n";
-  };
   out += "<Points>\n";
-  vectors("Points", s.x);
+  binary_array(out, "Float64", "Points", 3, flattened(s.x));
   out += "</Points>\n<PointData Scalars=\"radius\" Vectors=\"velocity\">\n";
-  out += "<DataArray type=\"Int64\" Name=\"id\" format=\"ascii\">\n";
-  for (auto id : s.id) out += fmt::format("{}\n", id);
-  out += "</DataArray>\n<DataArray type=\"Float64\" Name=\"radius\" format=\"ascii\">\n";
-  for (double r : s.radius) out += fmt::format("{:.9g}\n", r);
-  out += "</DataArray>\n";
-  vectors("velocity", s.v);
-  vectors("angular_velocity", s.w);
-  vectors("force", s.f);
-  out += "<DataArray type=\"Int64\" Name=\"body\" format=\"ascii\">\n";
+  binary_array(out, "Int64", "id", 1, std::vector<std::int64_t>(s.id.begin(), s.id.end()));
+  binary_array(out, "Float64", "radius", 1, std::vector<double>(s.radius.begin(), s.radius.end()));
+  binary_array(out, "Float64", "velocity", 3, flattened(s.v));
+  binary_array(out, "Float64", "angular_velocity", 3, flattened(s.w));
+  binary_array(out, "Float64", "force", 3, flattened(s.f));
   // A sphere is its own body; a clump is named by its first member.
+  std::vector<std::int64_t> body(s.size()), connectivity(s.size()), offsets(s.size());
   for (std::size_t i = 0; i < s.size(); ++i) {
     const std::int32_t b = s.body[i];
     const std::size_t named = b < 0 ? i : std::size_t(s.bodies.member[std::size_t(s.bodies.member_start[std::size_t(b)])]);
-    out += fmt::format("{}\n", s.id[named]);
+    body[i] = s.id[named];
+    connectivity[i] = std::int64_t(i);
+    offsets[i] = std::int64_t(i + 1);
   }
-  out += "</DataArray>\n</PointData>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (std::size_t i = 0; i < s.size(); ++i) out += fmt::format("{}\n", i);
-  out += "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-  for (std::size_t i = 0; i < s.size(); ++i) out += fmt::format("{}\n", i + 1);
-  out += "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-  for (std::size_t i = 0; i < s.size(); ++i) out += "1\n";  // VTK_VERTEX
-  out += "</DataArray>\n</Cells>\n</Piece></UnstructuredGrid>\n</VTKFile>\n";
+  binary_array(out, "Int64", "body", 1, body);
+  out += "</PointData>\n<Cells>\n";
+  binary_array(out, "Int64", "connectivity", 1, connectivity);
+  binary_array(out, "Int64", "offsets", 1, offsets);
+  binary_array(out, "UInt8", "types", 1, std::vector<std::uint8_t>(s.size(), 1));  // VTK_VERTEX
+  out += "</Cells>\n</Piece></UnstructuredGrid>\n</VTKFile>\n";
   diefill::write_file_atomic(path, out);
 }
 
@@ -176,17 +202,39 @@ State read_particles_vtu(const fs::path& path, int material, double density) {
   std::ifstream in(path);
   if (!in) throw InputError(path.string(), "", "cannot be read", "Check the path");
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // The byte count before each binary array: UInt32 unless the file says UInt64 (VTK's rule).
+  const std::size_t count_bytes = text.find("header_type=\"UInt64\"") != std::string::npos ? 8 : 4;
   auto array = [&](const std::string& name) {
     const std::size_t at = text.find("Name=\"" + name + "\"");
     if (at == std::string::npos)
       throw InputError(path.string(), "DataArray " + name, "is missing", "Give a VTU snapshot diefill wrote");
-    const std::size_t begin = text.find('>', at) + 1, end = text.find("</DataArray>", begin);
+    const std::size_t tag = text.rfind('<', at), begin = text.find('>', at) + 1, end = text.find("</DataArray>", begin);
+    const std::string attributes = text.substr(tag, begin - tag);
     std::vector<double> values;
-    std::istringstream numbers(text.substr(begin, end - begin));
-    for (double v; numbers >> v;) {
-      if (!std::isfinite(v)) throw InputError(path.string(), "DataArray " + name, "holds a non-finite value", "Correct the file");
-      values.push_back(v);
+    if (attributes.find("format=\"binary\"") != std::string::npos) {
+      std::vector<std::uint8_t> bytes;
+      const bool integers = attributes.find("type=\"Int64\"") != std::string::npos;
+      if (!diefill::base64_decode(std::string_view(text).substr(begin, end - begin), bytes) || bytes.size() < count_bytes ||
+          (bytes.size() - count_bytes) % 8 != 0 || (!integers && attributes.find("type=\"Float64\"") == std::string::npos))
+        throw InputError(path.string(), "DataArray " + name, "is not a binary Float64 or Int64 array diefill can read",
+                         "Give a VTU snapshot diefill wrote");
+      for (std::size_t b = count_bytes; b < bytes.size(); b += 8) {
+        double v;
+        if (integers) {
+          std::int64_t n;
+          std::memcpy(&n, bytes.data() + b, 8);
+          v = double(n);
+        } else {
+          std::memcpy(&v, bytes.data() + b, 8);
+        }
+        values.push_back(v);
+      }
+    } else {
+      std::istringstream numbers(text.substr(begin, end - begin));
+      for (double v; numbers >> v;) values.push_back(v);
     }
+    for (double v : values)
+      if (!std::isfinite(v)) throw InputError(path.string(), "DataArray " + name, "holds a non-finite value", "Correct the file");
     return values;
   };
   const std::vector<double> points = array("Points"), radius = array("radius"), ids = array("id");

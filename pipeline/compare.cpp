@@ -2,6 +2,8 @@
 
 #include <fmt/core.h>
 
+#include <array>
+#include <climits>
 #include <cmath>
 #include <fstream>
 
@@ -18,15 +20,23 @@ namespace {
 
 const char* const what_a_run_is = "Give a folder a diefill run wrote: OUT/<die name>/, with report.json and density.vdb";
 
+// A run's report, with the keys the comparison reads (a report of an older diefill may lack some).
 nlohmann::json read_report(const fs::path& run) {
   const fs::path file = run / "report.json";
   std::ifstream in(file);
   if (!in) throw diefill::InputError(run.string(), "report.json", "is missing: not a run's folder", what_a_run_is);
+  nlohmann::json report;
   try {
-    return nlohmann::json::parse(in);
+    report = nlohmann::json::parse(in);
   } catch (const nlohmann::json::exception& e) {
     throw diefill::InputError(file.string(), "", std::string("is not JSON: ") + e.what(), what_a_run_is);
   }
+  for (const char* key : {"/die/sha256", "/die/name", "/run/seed", "/run/scene_sha256", "/fill/fill_ratio", "/fill/mass_kg",
+                          "/fill/solid_fraction_mean", "/fill/solid_fraction_std", "/fill/regions", "/fill/profiles"})
+    if (!report.contains(nlohmann::json::json_pointer(key)))
+      throw diefill::InputError(file.string(), key, "is missing (a report of an older diefill, or of a run with an empty cavity)",
+                                "Run the die again with this version");
+  return report;
 }
 
 std::map<std::string, post::StoredGrid> read_fields(const fs::path& run) {
@@ -60,7 +70,8 @@ Difference difference(const std::map<std::string, post::StoredGrid>& a, const st
     throw diefill::InputError((run_b / "density.vdb").string(), prefix + "solid_fraction",
                               fmt::format("lies on another grid than {}'s ({:.4g} mm voxels against {:.4g} mm)", run_a.string(),
                                           phi_b.voxel_m * 1e3, phi_a.voxel_m * 1e3),
-                              "Compare runs of the same die with the same density.voxel and density.smoothed_width");
+                              prefix.empty() ? "Compare runs of the same die with the same density.voxel"
+                                             : "Compare runs of the same die with the same density.smoothed_width");
   Difference d;
   d.grid.voxel_m = phi_a.voxel_m;
   d.grid.first_centre = phi_a.first_centre;
@@ -95,17 +106,22 @@ nlohmann::json side_by_side(const nlohmann::json& a, const nlohmann::json& b) {
   return out;
 }
 
-// The difference's top view (each column's mean, -2 where the column is empty) and both runs'
-// profiles, for plots.py.
-nlohmann::json plot_data(const post::StoredGrid& diff, const nlohmann::json& a, const nlohmann::json& b) {
-  std::array<int, 3> lo{INT32_MAX, INT32_MAX, INT32_MAX}, hi{INT32_MIN, INT32_MIN, INT32_MIN};
+// The difference's top view (each column's cavity-weighted mean, as the runs' own top views;
+// -2 where the column is empty) and both runs' profiles, for plots.py.
+nlohmann::json plot_data(const post::StoredGrid& diff, const post::StoredGrid& cavity, const nlohmann::json& a,
+                         const nlohmann::json& b) {
+  nlohmann::json out = {{"profiles", {{"a", a["fill"]["profiles"]}, {"b", b["fill"]["profiles"]}}},
+                        {"labels", {a["run"]["label"], b["run"]["label"]}}};
+  if (diff.values.empty()) return out;
+  std::array<int, 3> lo{INT_MAX, INT_MAX, INT_MAX}, hi{INT_MIN, INT_MIN, INT_MIN};
   for (const auto& [index, value] : diff.values)
     for (int axis = 0; axis < 3; ++axis) lo[axis] = std::min(lo[axis], index[axis]), hi[axis] = std::max(hi[axis], index[axis]);
   const int nx = hi[0] - lo[0] + 1, ny = hi[1] - lo[1] + 1;
   std::vector<std::vector<double>> sum(std::size_t(nx), std::vector<double>(std::size_t(ny), 0.0)), count = sum;
   for (const auto& [index, value] : diff.values) {
-    sum[std::size_t(index[0] - lo[0])][std::size_t(index[1] - lo[1])] += value;
-    count[std::size_t(index[0] - lo[0])][std::size_t(index[1] - lo[1])] += 1;
+    const double weight = cavity.values.at(index);  // difference() keeps voxels with cavity only
+    sum[std::size_t(index[0] - lo[0])][std::size_t(index[1] - lo[1])] += weight * value;
+    count[std::size_t(index[0] - lo[0])][std::size_t(index[1] - lo[1])] += weight;
   }
   for (int i = 0; i < nx; ++i)
     for (int j = 0; j < ny; ++j) {
@@ -114,11 +130,10 @@ nlohmann::json plot_data(const post::StoredGrid& diff, const nlohmann::json& a, 
       s = n > 0 ? s / n : -2.0;
     }
   const double h = diff.voxel_m;
-  return {{"top_difference", sum},
-          {"extent_m", {diff.first_centre.x() + (lo[0] - 0.5) * h, diff.first_centre.x() + (hi[0] + 0.5) * h,
-                        diff.first_centre.y() + (lo[1] - 0.5) * h, diff.first_centre.y() + (hi[1] + 0.5) * h}},
-          {"profiles", {{"a", a["fill"]["profiles"]}, {"b", b["fill"]["profiles"]}}},
-          {"labels", {a["run"]["label"], b["run"]["label"]}}};
+  out["top_difference"] = sum;
+  out["extent_m"] = {diff.first_centre.x() + (lo[0] - 0.5) * h, diff.first_centre.x() + (hi[0] + 0.5) * h,
+                     diff.first_centre.y() + (lo[1] - 0.5) * h, diff.first_centre.y() + (hi[1] + 0.5) * h};
+  return out;
 }
 
 }  // namespace
@@ -148,7 +163,7 @@ nlohmann::json compare_runs(const fs::path& run_a, const fs::path& run_b, const 
   diefill::StagingFolder staged(out);
   diefill::write_file_atomic(staged / "compare.json", summary.dump(2) + "\n");
   post::write_vdb(grids, staged / "difference.vdb");
-  diefill::write_file_atomic(staged / "compare_plot.json", plot_data(exact.grid, a, b).dump());
+  diefill::write_file_atomic(staged / "compare_plot.json", plot_data(exact.grid, fields_a.at("cavity_fraction"), a, b).dump());
   draw_pictures({"compare", staged.path().string()});
   staged.commit();
   return summary;

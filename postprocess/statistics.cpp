@@ -21,7 +21,7 @@ struct WeightedSpread {
 // where voxels were merged; for the smoothed field, whose kernel spreads solid past the wall,
 // the kernel method's own ratio), kept where the bin's cavity reaches min_cavity of its voxels'
 // volume (the threshold below which the wall correction pools a voxel: fewer would read a
-// sliver as a value).
+// sliver as a value), counting the voxels that hold any cavity.
 template <typename Coordinate>
 Profile profile(const DensityField& f, const std::string& axis, Coordinate coordinate, double lo, double hi) {
   const VoxelGrid& g = f.grid;
@@ -34,8 +34,8 @@ Profile profile(const DensityField& f, const std::string& axis, Coordinate coord
       for (int k = 0; k < g.nz; ++k) {
         const std::size_t n = g.index(i, j, k);
         const auto b = std::size_t(std::clamp(int(std::floor((coordinate(g.centre(i, j, k)) - lo) / g.voxel)), 0, bins - 1));
+        if (f.cavity[n] <= 0) continue;  // the grid's margins are no part of any bin
         volume[b] += v;
-        if (f.cavity[n] <= 0) continue;
         cavity[b] += f.cavity[n] * v;
         if (std::isfinite(f.corrected.solid_fraction[n])) spread[b].add(f.corrected.solid_fraction[n], f.cavity[n]);
       }

@@ -198,7 +198,8 @@ print(json.dumps({"names": names, "voxel": phi.transform.voxelSize()[0], "units"
   while (std::size_t n = std::fread(buffer, 1, sizeof buffer, pipe)) text.append(buffer, n);
   ASSERT_EQ(::pclose(pipe), 0) << text;
   const auto j = nlohmann::json::parse(text);
-  EXPECT_EQ(j["names"], nlohmann::json({"cavity_fraction", "density", "merged", "solid_fraction"}));
+  EXPECT_EQ(j["names"], nlohmann::json({"cavity_fraction", "density", "merged", "smoothed_cavity_fraction", "smoothed_density",
+                                        "smoothed_solid_fraction", "solid_fraction"}));
   EXPECT_DOUBLE_EQ(j["voxel"].get<double>(), 1e-3);
   EXPECT_EQ(j["units"], "m");
   EXPECT_EQ(j["coarse_graining"], "8");  // as the pipeline's field records it
@@ -230,7 +231,8 @@ TEST(CliDensity, BadInputLeavesNoPartialOutput) {
   expect_refused("id,x,y,z,vx,vy,vz,wx,wy,wz,radius,density\n1,0.5,0.5,0.5,0,0,0,0,0,0,1e-3,7800\n", "lies in the cavity", die);
 }
 
-// compare and sweep refuse what they cannot do, naming the folder or the option, and write nothing.
+// compare and sweep refuse what they cannot do (not a run's folder, a broken or older report, a
+// sweep without values or over a folder), naming the folder or the option, and write nothing.
 TEST(CliCompare, RefusesFoldersThatAreNotRunsAndBadSweeps) {
   test::TempDir dir;
   std::filesystem::create_directories(dir / "empty");
@@ -239,6 +241,9 @@ TEST(CliCompare, RefusesFoldersThatAreNotRunsAndBadSweeps) {
   expect_bad_input("compare " + (dir / "empty").string() + " " + (dir / "empty").string() + out, "report.json", "not a run's folder");
   test::write_text(dir / "broken" / "report.json", "{not json");
   expect_bad_input("compare " + (dir / "broken").string() + " " + (dir / "broken").string() + out, "report.json", "is not JSON");
+  std::filesystem::create_directories(dir / "old");
+  test::write_text(dir / "old" / "report.json", R"({"die": {"sha256": "0", "name": "ring"}, "fill": {"fill_ratio": 0.5}})");
+  expect_bad_input("compare " + (dir / "old").string() + " " + (dir / "old").string() + out, "/run/seed", "older diefill");
   EXPECT_FALSE(std::filesystem::exists(dir / "compared"));
   expect_bad_input("run " + (test::source_dir() / "dies" / "ring.stl").string() + " --sweep motion.speed --out " + (dir / "swept").string(),
                    "--sweep", "KEY=VALUE");

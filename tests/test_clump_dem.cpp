@@ -5,11 +5,13 @@
 #include <omp.h>
 
 #include <chrono>
+#include <cstring>
 #include <cmath>
 #include <fstream>
 #include <numbers>
 #include <optional>
 
+#include "core/base64.hpp"
 #include "core/error.hpp"
 #include "dem/bodies.hpp"
 #include "dem/checkpoint.hpp"
@@ -319,11 +321,26 @@ TEST(ClumpFiles, CsvAndSnapshotNameTheBodyAndTheCsvIsRefusedOnInput) {
   EXPECT_NE(member.find(",2500,0,"), std::string::npos) << member;
   EXPECT_TRUE(sphere.ends_with(",-1,1,0,0,0")) << sphere;
   EXPECT_THROW(dem::read_particles_csv(dir / "p.csv", 0, 2500), diefill::InputError);
-  // Snapshots name a clump by its first member's id.
+  // Snapshots name a clump by its first member's id (a binary array: a UInt64 byte count, then
+  // the Int64 ids).
   dem::write_vtu(s, dir / "p.vtu");
   std::ifstream vtu(dir / "p.vtu");
   const std::string text((std::istreambuf_iterator<char>(vtu)), std::istreambuf_iterator<char>());
-  EXPECT_NE(text.find("Name=\"body\" format=\"ascii\">\n0\n0\n0\n0\n99\n"), std::string::npos);
+  const std::size_t begin = text.find('>', text.find("Name=\"body\"")) + 1;
+  std::vector<std::uint8_t> bytes;
+  ASSERT_TRUE(diefill::base64_decode(std::string_view(text).substr(begin, text.find("</DataArray>", begin) - begin), bytes));
+  ASSERT_EQ(bytes.size(), 8u + 5 * 8);
+  std::vector<std::int64_t> body(5);
+  std::memcpy(body.data(), bytes.data() + 8, 5 * 8);
+  EXPECT_EQ(body, (std::vector<std::int64_t>{0, 0, 0, 0, 99}));
+  // Read back exactly (the arrays are binary), as `diefill density` reads a snapshot.
+  const dem::State back = dem::read_particles_vtu(dir / "p.vtu", 0, 2500);
+  ASSERT_EQ(back.size(), s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    EXPECT_EQ(back.id[i], s.id[i]);
+    EXPECT_EQ(back.x[i], s.x[i]);
+    EXPECT_EQ(back.radius[i], s.radius[i]);
+  }
 }
 
 // Cost of clumps: a settled pack of about 2000 clumps of 1, 2, 4 and 8 spheres (and loose

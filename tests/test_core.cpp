@@ -1,7 +1,10 @@
 // core: hashing and atomic output.
 #include <gtest/gtest.h>
 
+#include <cstring>
+
 #include "core/atomic_file.hpp"
+#include "core/base64.hpp"
 #include "core/error.hpp"
 #include "core/sha256.hpp"
 #include "support.hpp"
@@ -14,6 +17,21 @@ TEST(Sha256, MatchesFipsVectors) {
   // A million 'a': crosses many blocks and the padding boundary.
   EXPECT_EQ(diefill::sha256_hex(std::string(1000000, 'a')),
             "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+}
+
+// RFC 4648's test vectors, both ways, and a character outside the alphabet refused.
+TEST(Base64, MatchesRfc4648Vectors) {
+  const std::pair<const char*, const char*> vectors[] = {{"", ""},         {"f", "Zg=="},         {"fo", "Zm8="},
+                                                         {"foo", "Zm9v"}, {"foob", "Zm9vYg=="}, {"fooba", "Zm9vYmE="},
+                                                         {"foobar", "Zm9vYmFy"}};
+  for (const auto& [plain, encoded] : vectors) {
+    EXPECT_EQ(diefill::base64_encode(plain, std::strlen(plain)), encoded);
+    std::vector<std::uint8_t> decoded;
+    ASSERT_TRUE(diefill::base64_decode(encoded, decoded));
+    EXPECT_EQ(std::string(decoded.begin(), decoded.end()), plain);
+  }
+  std::vector<std::uint8_t> decoded;
+  EXPECT_FALSE(diefill::base64_decode("Zm9v!", decoded));
 }
 
 TEST(AtomicFile, ReplacesOnlyWhenComplete) {

@@ -347,10 +347,14 @@ TEST(Pipeline, SweepRunsEachCaseAsItsSingleRun) {
     EXPECT_EQ(runs[k].report["final_state_sha256"], single["final_state_sha256"]) << "at " << speeds[k] << " m/s";
     EXPECT_EQ(read_text(runs[k].dir / "particles.csv"), read_text(output_of("ring", folder) / "particles.csv")) << speeds[k];
   }
-  const std::string table = read_text(base / "sweep.csv");
+  const std::string table = read_text(base / "sweep_motion.speed.csv");
   EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 4) << table;
-  EXPECT_TRUE(fs::exists(base / "sweep.png"));
+  EXPECT_TRUE(fs::exists(base / "sweep_motion.speed.png"));
   EXPECT_THROW(app::parse_sweep("motion.speed"), diefill::InputError);
+  EXPECT_THROW(app::run_sweep(load, app::parse_sweep("output.directory=a,b"), nullptr), diefill::InputError);
+  // A bad last value is refused before the first case runs.
+  EXPECT_THROW(app::run_sweep(load, app::parse_sweep("powder.coarse_graining=16,-1"), nullptr), diefill::InputError);
+  EXPECT_FALSE(fs::exists(base / "powder.coarse_graining=16")) << "no case ran";
 }
 
 TEST(Pipeline, SameSceneAndSeedGiveTheSameReportAndGrains) {
