@@ -25,11 +25,8 @@ mesh::DieOptions die_options(const PipelineScene& s, const GrainSizing& grains, 
   o.up = source.file.up;
   o.role = mesh::WallRole::cavity;
   // Room beside the shoe: grains that pass under its walls (the strike-off) stay on the table
-  // rather than falling off a table the size of the shoe, as on a press, whose table reaches far
-  // beyond the shoe. Two radii let one grain in 2000 off; 2 mm and six radii still let one to two
-  // of 2005 off the ring's table (coarse graining 16) in about half the runs resumed on another
-  // rank count, and one of 16 042 off at the default. The table costs nothing where no grain is.
-  const double margin = 10e-3 + 6 * r;
+  // rather than falling off a table the size of the shoe (two radii let one grain in 2000 off).
+  const double margin = 2e-3 + 6 * r;
   o.table = mesh::TableExtent{shoe.x_start - 0.5 * shoe.length - s.shoe_wall - margin,
                               shoe.y_centre - 0.5 * shoe.width - s.shoe_wall - margin,
                               shoe.x_end + 0.5 * shoe.length + s.shoe_wall + margin,
