@@ -98,7 +98,17 @@ TEST(MpiRun, ACheckpointOfTwoRanksResumesOnThree) {
   EXPECT_NE(resumed.output.find("resumed at"), std::string::npos) << resumed.output;
   const nlohmann::json report = nlohmann::json::parse(test::read_text(dir / "ring" / "report.json"));
   EXPECT_EQ(report["timing"]["ranks"], 3);
-  expect_fills_as_one_process(report, "resumed on 3 ranks");
+  // The resumed trajectory depends on when the interrupt landed, so it is one more draw of the
+  // fill, not the uninterrupted run's: every grain counted, and the fill within the seeds'
+  // spread. A grain or two may spill over the table's edge beside the shoe in such a draw
+  // (measured this session: 1 and 2 of 2005 in two of three draws; the default ring spills one
+  // of 16 042 single-process): counted as particles.lost, harmless to the fill, issue 19's
+  // "lost 0" point. A grain through the die would have stopped the run (check_losses).
+  const nlohmann::json& p = report["particles"];
+  EXPECT_EQ(p["inserted"], grains_inserted_on_seed_1);
+  EXPECT_EQ(p["inserted"].get<std::int64_t>(), p["in_cavity"].get<std::int64_t>() + p["in_shoe"].get<std::int64_t>() +
+                                                   p["elsewhere"].get<std::int64_t>() + p["lost"].get<std::int64_t>());
+  EXPECT_NEAR(report["fill"]["fill_ratio"].get<double>(), single_process_fill_mean, 4 * single_process_fill_sd);
   EXPECT_NEAR(report["fill"]["fill_ratio"].get<double>(), uninterrupted["fill"]["fill_ratio"].get<double>(),
               4 * single_process_fill_sd);
   EXPECT_FALSE(fs::exists(dir / "ring" / "checkpoint.bin")) << "a finished run removes its checkpoint";
