@@ -1,0 +1,86 @@
+// CGAL Mesh_3 on a polyhedral domain with protected features (the sharp edges of the surface
+// are sampled by protecting balls first, so that the mesh's edges follow them).
+#include "mesh/tetmesh.hpp"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Mesh_complex_3_in_triangulation_3.h>
+#include <CGAL/Mesh_criteria_3.h>
+#include <CGAL/Mesh_triangulation_3.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polyhedral_mesh_domain_with_features_3.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/make_mesh_3.h>
+#include <fmt/core.h>
+
+#include <map>
+
+#include "core/error.hpp"
+
+namespace mesh {
+
+namespace {
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = K::Point_3;
+using SurfaceMesh = CGAL::Surface_mesh<Point>;
+using Domain = CGAL::Polyhedral_mesh_domain_with_features_3<K, SurfaceMesh>;
+// Sequential: the parallel mesher's result depends on the thread schedule.
+using Tr = CGAL::Mesh_triangulation_3<Domain, CGAL::Default, CGAL::Sequential_tag>::type;
+using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Tr, Domain::Corner_index, Domain::Curve_index>;
+using Criteria = CGAL::Mesh_criteria_3<Tr>;
+
+SurfaceMesh surface_mesh(const TriMesh& m) {
+  std::vector<Point> points;
+  points.reserve(m.vertices.size());
+  for (const Vec3& v : m.vertices) points.emplace_back(v.x(), v.y(), v.z());
+  std::vector<std::array<std::size_t, 3>> faces;
+  faces.reserve(m.triangles.size());
+  for (const Triangle& t : m.triangles) faces.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
+  SurfaceMesh sm;
+  CGAL::Polygon_mesh_processing::polygon_soup_to_polygon_mesh(points, faces, sm);
+  return sm;
+}
+}  // namespace
+
+TetMesh tetrahedralise(const TriMesh& surface, const TetMeshOptions& o, const std::string& source) {
+  if (!(o.element_size_m > 0) || !(o.facet_distance_m > 0))
+    throw diefill::InputError(source, "fem.element_size", "element size and facet distance must be positive",
+                              "Give a positive element size");
+  SurfaceMesh sm = surface_mesh(surface);
+  CGAL::Random seeded(0);  // the domain's own sampling; make_mesh_3 reseeds CGAL's default generator
+  Domain domain(sm, &seeded);
+  domain.detect_features(o.feature_angle_deg);
+  namespace params = CGAL::parameters;
+  // Radius-edge ratio 2 and facet angle 25° are CGAL's documented bounds for which refinement
+  // terminates; perturbation and exudation then remove slivers (without a time limit, which
+  // would make the result depend on the machine's speed).
+  const Criteria criteria(params::edge_size = o.element_size_m, params::facet_angle = 25,
+                          params::facet_size = o.element_size_m, params::facet_distance = o.facet_distance_m,
+                          params::cell_radius_edge_ratio = 2, params::cell_size = o.element_size_m);
+  C3t3 c3t3 = CGAL::make_mesh_3<C3t3>(domain, criteria, params::perturb(params::time_limit = 0),
+                                      params::exude(params::time_limit = 0));
+
+  TetMesh out;
+  std::map<Tr::Vertex_handle, int> index;
+  const Tr& tr = c3t3.triangulation();
+  auto node = [&](Tr::Vertex_handle v) {
+    auto [it, added] = index.emplace(v, int(out.nodes.size()));
+    if (added) {
+      const Point p = tr.geom_traits().construct_point_3_object()(tr.point(v));
+      out.nodes.emplace_back(p.x(), p.y(), p.z());
+    }
+    return it->second;
+  };
+  for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c) {
+    Tet t{node(c->vertex(0)), node(c->vertex(1)), node(c->vertex(2)), node(c->vertex(3))};
+    if (tet_volume(out.nodes[t[0]], out.nodes[t[1]], out.nodes[t[2]], out.nodes[t[3]]) < 0) std::swap(t[2], t[3]);
+    out.tets.push_back(t);
+  }
+  for (auto e = c3t3.edges_in_complex_begin(); e != c3t3.edges_in_complex_end(); ++e)
+    out.feature_edges.push_back({node(e->first->vertex(e->second)), node(e->first->vertex(e->third))});
+  if (out.tets.empty())
+    throw diefill::InputError(source, "surface", "CGAL's mesher made no tetrahedron inside it",
+                              "Check that the die is a closed solid larger than the element size");
+  return out;
+}
+
+}  // namespace mesh
