@@ -9,6 +9,7 @@
 #include "dem/io.hpp"
 #include "dem/step.hpp"
 #include "pipeline/density_stage.hpp"
+#include "pipeline/fem_stage.hpp"
 #include "pipeline/fill_curve.hpp"
 #include "pipeline/pictures.hpp"
 #include "scene/physics_keys.hpp"
@@ -39,6 +40,18 @@ nlohmann::json write_density_field(const FillRecord& r, const fs::path& dir) {
   return fill;
 }
 
+// The FEM hand-off (fem/), on elements as large as the density voxels unless the scene says.
+nlohmann::json write_fem_section(const FillRecord& r, const nlohmann::json& fill, const fs::path& dir) {
+  if (r.census.cavity.empty()) return nullptr;
+  FemSettings settings;
+  settings.element_size_m = r.scene.fem_element_size > 0 ? r.scene.fem_element_size : fill.at("voxel_m").get<double>();
+  settings.sub_voxel_m = std::min(0.5 * r.grains.diameter, 0.25 * settings.element_size_m);
+  settings.quadratic = r.scene.fem_elements == "quadratic";
+  settings.compaction = r.scene.fem_compaction == "calculix";
+  const double density = r.walls.spec.materials[std::size_t(r.walls.powder)].density;
+  return write_fem_outputs(r.census.cavity, r.walls.die, *r.walls.die_field, density, fill.at("mass_kg"), settings, dir);
+}
+
 // The fill curve (CSV and chart; it ends at the field's mass, fill.mass_kg) and what the report
 // says of it: the cavity's capacity (its volume full of solid material) and the strike-off.
 nlohmann::json write_fill_curve_outputs(const FillRecord& r, const fs::path& dir) {
@@ -63,7 +76,7 @@ std::string scene_hash(const PipelineScene& s) {
   return diefill::sha256_hex(text + describe_materials(s.spec));
 }
 
-nlohmann::json report_json(const FillRecord& r, const nlohmann::json& fill) {
+nlohmann::json report_json(const FillRecord& r, const nlohmann::json& fill, const nlohmann::json& fem) {
   const PipelineScene& s = r.scene;
   const mesh::PreparedDie& die = r.walls.die;
   const bool clumps = !s.shape_mesh.empty();
@@ -96,6 +109,7 @@ nlohmann::json report_json(const FillRecord& r, const nlohmann::json& fill) {
         {"speed_m_s", s.speed},
         {"passes", s.passes}}},
       {"fill", fill},
+      {"fem", fem},
       {"particles",
        {{"inserted", r.census.grains},
         {"in_cavity", r.census.in_cavity},
@@ -129,10 +143,11 @@ nlohmann::json write_fill_outputs(const FillRecord& r, const fs::path& dir) {
   diefill::StagingFolder out(dir);
   nlohmann::json fill = write_density_field(r, out.path());
   fill.update(write_fill_curve_outputs(r, out.path()));
+  const nlohmann::json fem = write_fem_section(r, fill, out.path());
   dem::write_particles_csv(r.fill.state, out / "particles.csv");
   dem::write_vtu(r.fill.state, out / "final.vtu");
   diefill::write_file_atomic(out / "scene.toml", describe(r.scene));
-  const nlohmann::json report = report_json(r, fill);
+  const nlohmann::json report = report_json(r, fill, fem);
   diefill::write_file_atomic(out / "report.json", report.dump(2) + "\n");
   out.commit();
   diefill::log::info("{}: {} of {} grains in the cavity, fill ratio {:.3f}, mean solid fraction {:.3f} -> {}", r.walls.die.name,

@@ -284,8 +284,26 @@ def sweep(summary: Path) -> None:
     plt.close(fig)
 
 
+def compaction(document: Path) -> None:
+    """The worked CalculiX example: each element's axial stress against its fill solid fraction."""
+    data = json.loads(document.read_text())
+    phi = np.array(data["solid_fraction"], dtype=float)
+    stress = -np.array(data["axial_stress_pa"], dtype=float) / 1e6  # compressive positive
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    ax.scatter(phi, stress, s=4, alpha=0.4)
+    ax.set_xlabel("fill solid fraction of the element [-]")
+    ax.set_ylabel("axial stress, compressive [MPa]")
+    ax.set_title(f"Punch at {100 * data['axial_strain']:.3g} % strain: {data['punch_force_n'] / 1e3:.4g} kN\n"
+                 "(linear elastic, E tabulated against the fill; CalculiX)", fontsize="medium")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(document.with_suffix(".png"), dpi=120)
+    plt.close(fig)
+
+
 if __name__ == "__main__":
     if sys.argv[1] == "fill_curve":
         fill_curve(Path(sys.argv[2]), float(sys.argv[3]))
     else:
-        {"density": density, "clump": clump, "study": study, "compare": compare, "sweep": sweep}[sys.argv[1]](Path(sys.argv[2]))
+        {"density": density, "clump": clump, "study": study, "compare": compare, "sweep": sweep,
+         "compaction": compaction}[sys.argv[1]](Path(sys.argv[2]))

@@ -118,6 +118,12 @@ KeyTable<P> make_pipeline_keys() {
                    "exact volume split, or Gaussian coarse graining", &P::density_method));
   k.push_back(number("density", "smoothed_width", "m", {0, metre_range_hi}, run,
                      "the smoothed field's Gaussian width and voxel; 0: half a grain diameter", &P::density_smoothed_width));
+  k.push_back(number("fem", "element_size", "m", {0, metre_range_hi}, run,
+                     "the tetrahedra's largest edge in fem/fill.inp; 0: the density voxel", &P::fem_element_size));
+  k.push_back(text("fem", "elements", KeyType::choice, {"linear", "quadratic"}, run,
+                   "C3D4, or C3D10 with a node on every edge", &P::fem_elements));
+  k.push_back(text("fem", "compaction", KeyType::choice, {"calculix", "none"}, run,
+                   "the worked example: the fill pressed by a punch in CalculiX (fem/compaction.*)", &P::fem_compaction));
   k.push_back(text("output", "directory", KeyType::text, {}, nothing, "each die writes into DIRECTORY/<die name>/ (relative "
                    "to the working folder)", &P::out));
   k.push_back(text("output", "cache", KeyType::text, {}, nothing, "prepared die fields and settled shoes, reused by runs "

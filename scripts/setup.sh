@@ -27,6 +27,7 @@ packages=(
   python3-matplotlib                        # the pictures of reports and studies
   libopenmpi-dev openmpi-bin                # the DEM split over MPI ranks (dem/mpi_exchange.hpp)
   libtrilinos-zoltan-dev                    # the partitioner benchmark's reference (bench/partition.cpp)
+  calculix-ccx                              # the FEM hand-off's worked compaction example and its tests
 )
 missing=()
 for p in "${packages[@]}"; do

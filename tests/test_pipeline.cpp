@@ -5,6 +5,7 @@
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <fstream>
@@ -320,6 +321,44 @@ TEST(Pipeline, CompareGivesTheDifferenceOfTwoSeeds) {
   run("disc", 0.1, 1);
   EXPECT_THROW(app::compare_runs(output_of("ring"), output_of("disc"), suite_out() / "compare_dies"), diefill::InputError);
   EXPECT_FALSE(fs::exists(suite_out() / "compare_dies")) << "nothing written for a refused comparison";
+}
+
+// The FEM hand-off of a run (docs/INTERFACE.md, "FEM hand-off"): on the ring and the disc the
+// elements hold the grains' mass in the cavity (each grain's part below the table, summed here
+// from particles.csv) within 0.5 % and fill the cavity's volume within 0.5 %; no element is
+// inverted; CalculiX reads the deck without a warning; and pressed by the punch, the densest
+// quarter of the elements carries a larger mean axial stress than the loosest quarter.
+TEST(Pipeline, FemHandOffHoldsTheCavitysMassAndCompactsDenserElementsHarder) {
+  for (const std::string die : {"ring", "disc"}) {
+    const nlohmann::json& report = run(die, 0.1, 1);
+    const nlohmann::json& fem = report.at("fem");
+    const dem::State s = dem::read_particles_csv(output_of(die) / "particles.csv", 0, 7800);
+    double below_table = 0;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      const double r = s.radius[i], z = s.x[i].z();
+      if (s.x[i].head<2>().norm() > 10e-3 + r || z > r) continue;  // outside the die's Ø20 mm opening
+      const double h = std::clamp(r - z, 0.0, 2 * r);                 // the cap below the table
+      below_table += std::numbers::pi * h * h * (3 * r - h) / 3;
+    }
+    const double mass = below_table * report["powder"]["material_density"].get<double>();
+    std::printf("%s: %zu elements, mass %.6g kg against %.6g kg in the cavity, volume %+.3f %%, dihedral >= %.1f°, "
+                "axial stress %.4g (densest quarter) and %.4g MPa (loosest)\n",
+                die.c_str(), fem["elements"].get<std::size_t>(), fem["mass_kg"].get<double>(), mass,
+                100 * fem["volume_error_rel"].get<double>(), fem["min_dihedral_deg"].get<double>(),
+                fem["compaction"]["densest_quarter_axial_stress_pa"].get<double>() / 1e6,
+                fem["compaction"]["loosest_quarter_axial_stress_pa"].get<double>() / 1e6);
+    EXPECT_NEAR(fem["mass_kg"].get<double>() / mass, 1.0, 0.005) << die;
+    EXPECT_NEAR(fem["volume_error_rel"].get<double>(), 0.0, 0.005) << die;
+    EXPECT_EQ(fem["inverted_elements"].get<int>(), 0) << die;
+    EXPECT_GT(fem["min_dihedral_deg"].get<double>(), 10.0) << die;
+    const std::string log = read_text(output_of(die) / "fem" / "ccx.log");
+    EXPECT_EQ(log.find("WARNING"), std::string::npos) << log;
+    EXPECT_EQ(log.find("ERROR"), std::string::npos) << log;
+    // Compressive stresses are negative: the densest quarter's is the more negative.
+    EXPECT_LT(fem["compaction"]["densest_quarter_axial_stress_pa"].get<double>(),
+              fem["compaction"]["loosest_quarter_axial_stress_pa"].get<double>()) << die;
+    EXPECT_TRUE(fs::exists(output_of(die) / "fem" / "compaction.png")) << die;
+  }
 }
 
 // A sweep over three shoe speeds: one folder per case, the summary table and chart; each case is

@@ -1,0 +1,91 @@
+#include "pipeline/fem_stage.hpp"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <numeric>
+
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "mesh/tetmesh.hpp"
+#include "pipeline/pictures.hpp"
+#include "postprocess/compaction.hpp"
+
+namespace app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The worked example's result: the punch force and the mean axial stress of the densest and the
+// loosest quarter of the elements (by count), with every element's pair for the picture.
+nlohmann::json compaction_example(const post::FemFill& fill, const fs::path& dir) {
+  const post::CompactionSettings s;
+  const post::CompactionResult r = post::run_compaction(fill, dir, s);
+  std::vector<std::size_t> order(fill.element_fraction.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return fill.element_fraction[a] < fill.element_fraction[b]; });
+  const std::size_t quarter = order.size() / 4;
+  auto mean_stress = [&](std::size_t first, std::size_t last) {
+    double sum = 0;
+    for (std::size_t i = first; i < last; ++i) sum += r.element_axial_stress[order[i]];
+    return sum / double(std::max<std::size_t>(1, last - first));
+  };
+  diefill::write_file_atomic(dir / "compaction.json",
+                             nlohmann::json{{"solid_fraction", fill.element_fraction}, {"axial_stress_pa", r.element_axial_stress},
+                                            {"axial_strain", s.axial_strain}, {"punch_force_n", r.punch_force_n}}
+                                 .dump());
+  draw_pictures({"compaction", (dir / "compaction.json").string()});
+  return {{"axial_strain", s.axial_strain},
+          {"punch_travel_m", r.punch_travel_m},
+          {"punch_force_n", r.punch_force_n},
+          {"loosest_quarter_axial_stress_pa", mean_stress(0, quarter)},
+          {"densest_quarter_axial_stress_pa", mean_stress(order.size() - quarter, order.size())}};
+}
+
+}  // namespace
+
+nlohmann::json write_fem_outputs(const std::vector<post::Grain>& grains, const mesh::PreparedDie& die, const mesh::WallField& walls,
+                                 double material_density, double mass_in_cavity_kg, const FemSettings& s, const fs::path& dir) {
+  mesh::TetMesh tets = mesh::tetrahedralise(die.cavity, {s.element_size_m, s.element_size_m / 200, 60}, die.source);
+  const mesh::TetQuality q = mesh::tet_quality(tets);
+  const post::CavityShape cavity{[&](const post::Vec3& p) { return walls.signed_distance(p); }, die.after.bbox.lo,
+                                 post::Vec3(die.after.bbox.hi.x(), die.after.bbox.hi.y(), die.table_z)};
+  const post::FemFill fill = post::fill_elements(std::move(tets), grains, cavity, s.sub_voxel_m, material_density);
+  const fs::path fem = dir / "fem";
+  fs::create_directories(fem);
+  post::write_fem(fill, s.quadratic, fmt::format("diefill fill of {} ({})", die.name, die.source), fem);
+  const double mesh_volume = std::accumulate(fill.element_volume.begin(), fill.element_volume.end(), 0.0);
+  const double mass = fill.solid_volume_m3 * material_density;
+  const auto [lo, hi] = std::minmax_element(fill.element_fraction.begin(), fill.element_fraction.end());
+  nlohmann::json j = {
+      {"files", {"fem/fill.inp", "fem/fill_abaqus.inp", "fem/fill_calculix.inp", "fem/fill.vtu"}},
+      {"element_type", s.quadratic ? "C3D10" : "C3D4"},
+      {"elements", fill.mesh.tets.size()},
+      {"nodes", s.quadratic ? post::quadratic(fill).nodes.size() : fill.mesh.nodes.size()},
+      {"element_size_m", s.element_size_m},
+      {"sub_voxel_m", fill.sub_voxel_m},
+      {"min_dihedral_deg", q.min_dihedral_deg},
+      {"max_dihedral_deg", q.max_dihedral_deg},
+      {"min_radius_ratio", q.min_radius_ratio},
+      {"mean_radius_ratio", q.mean_radius_ratio},
+      {"inverted_elements", q.inverted},
+      {"mesh_volume_m3", mesh_volume},
+      {"volume_error_rel", mesh_volume / die.after.volume_m3 - 1},
+      {"mass_kg", mass},
+      {"mass_error_rel", mass_in_cavity_kg > 0 ? mass / mass_in_cavity_kg - 1 : 0.0},
+      {"mass_scale", fill.mass_scale},
+      {"solid_fraction_min", *lo},
+      {"solid_fraction_max", *hi}};
+  if (s.compaction) {
+    try {
+      j["compaction"] = compaction_example(fill, fem);
+    } catch (const diefill::InputError& e) {
+      diefill::log::warn("{}: the CalculiX compaction example did not run: {}", die.name, e.what());
+    }
+  }
+  return j;
+}
+
+}  // namespace app

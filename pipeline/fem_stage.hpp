@@ -1,0 +1,28 @@
+#pragma once
+// The FEM hand-off stage (docs/INTERFACE.md, "FEM hand-off"): the cavity's tetrahedral mesh with
+// the fill's solid fraction per element and node, the Abaqus/CalculiX files, and the worked
+// CalculiX compaction example.
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "mesh/die.hpp"
+#include "postprocess/density.hpp"
+
+namespace app {
+
+struct FemSettings {
+  double element_size_m = 1.6e-3;
+  double sub_voxel_m = 0.2e-3;     // the exact binning the elements' values are integrated from
+  bool quadratic = false;          // C3D10 instead of C3D4
+  bool compaction = true;          // run the CalculiX example (a warning when ccx is missing)
+};
+
+// Writes `dir`/fem/ and returns the report's `fem` section; `mass_in_cavity_kg` is the density
+// field's (fill.mass_kg), which the elements' mass is checked against.
+nlohmann::json write_fem_outputs(const std::vector<post::Grain>& cavity_grains, const mesh::PreparedDie& die,
+                                 const mesh::WallField& walls, double material_density, double mass_in_cavity_kg,
+                                 const FemSettings& settings, const std::filesystem::path& dir);
+
+}  // namespace app
