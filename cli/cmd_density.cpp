@@ -5,6 +5,7 @@
 
 #include "cli/commands.hpp"
 #include "pipeline/density_stage.hpp"
+#include "pipeline/fem_stage.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "dem/io.hpp"
@@ -52,6 +53,13 @@ int run_density(const DensityCommand& c) {
                            {"density", {{"voxel_m", s.voxel_m}, {"method", s.method}, {"smoothed_width_m", s.smoothed_width_m}, {"material_density", material_density},
                                         {"coarse_graining", c.coarse_graining}}},
                            {"fill", statistics_json(result.stats)}};
+  if (c.fem) {
+    FemSettings fem;
+    fem.element_size_m = c.element_size_mm > 0 ? c.element_size_mm * 1e-3 : s.voxel_m;
+    fem.sub_voxel_m = std::min(r_max, 0.25 * fem.element_size_m);  // half the largest grain diameter, as the pipeline
+    fem.quadratic = c.elements == "quadratic";
+    report["fem"] = write_fem_outputs(grains, die, walls, material_density, result.stats.mass_kg, fem, out.path());
+  }
   diefill::write_file_atomic(out / "density.json", report.dump(2) + "\n");
   out.commit();
   fmt::print("{}: mean solid fraction {:.4f} (std {:.4f}, min {:.4f}, max {:.4f}) over {} voxels; fill ratio {:.4f} -> {}\n",

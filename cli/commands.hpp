@@ -87,6 +87,9 @@ struct DensityCommand {
   double smoothed_width_mm = 0;  // the smoothed field's width (0: half the largest grain diameter)
   double material_density = 0;  // 0: from the particle file
   double coarse_graining = 1;    // α of the file's grains over the real powder's (1: they are the powder)
+  bool fem = false;              // also the FEM hand-off (fem/)
+  double element_size_mm = 0;    // 0: the voxel
+  std::string elements = "linear";
 };
 int run_density(const DensityCommand& command);
 

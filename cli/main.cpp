@@ -95,6 +95,12 @@ void add_density(CLI::App& root, app::DensityCommand& c, std::function<int()>& a
                   "The file's grains over the real powder's size, recorded in the field (1: they are the powder)")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 1e4));
+  cmd->add_flag("--fem", c.fem, "Also the FEM hand-off in OUTPUT/fem/: tetrahedral mesh with the fill per element (fill.inp, fill.vtu) "
+                                "and the CalculiX compaction example");
+  cmd->add_option("--element-size", c.element_size_mm, "The tetrahedra's largest edge [mm] (default: the voxel)");
+  cmd->add_option("--elements", c.elements, "linear (C3D4) or quadratic (C3D10)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"linear", "quadratic"}));
   cmd->callback([&] { action = [&] { return app::run_density(c); }; });
 }
 
