@@ -77,10 +77,20 @@ StagingFolder::~StagingFolder() {
 void StagingFolder::commit() {
   for (const auto& entry : fs::directory_iterator(staging_)) {
     std::error_code ec;
-    fs::rename(entry.path(), target_ / entry.path().filename(), ec);
+    const fs::path target = target_ / entry.path().filename();
+    // A folder (fem/) replaces the earlier one whole: none of the earlier run's files stays in it.
+    // Renamed aside first, since a folder cannot be renamed onto a folder that holds files.
+    const fs::path aside = target_ / (".replaced-" + entry.path().filename().string());
+    const bool replace_folder = entry.is_directory() && fs::is_directory(target);
+    if (replace_folder) {
+      fs::remove_all(aside, ec);
+      fs::rename(target, aside, ec);
+    }
+    if (!ec) fs::rename(entry.path(), target, ec);
     if (ec)
       throw InputError((target_ / entry.path().filename()).string(), "", "cannot be written (" + ec.message() + ")",
                        "Check that the output folder is writable");
+    if (replace_folder) fs::remove_all(aside, ec);  // the new one is in place: a leftover costs only space
   }
   committed_ = true;
 }

@@ -39,6 +39,28 @@ SurfaceMesh surface_mesh(const TriMesh& m) {
   CGAL::Polygon_mesh_processing::polygon_soup_to_polygon_mesh(points, faces, sm);
   return sm;
 }
+// A cell whose four vertices lie in one plane (to rounding; exactly, they need not) with two or more faces on the boundary:
+// a sliver Mesh_3 can leave lying on a flat part of the surface (on the gear die's wall, between
+// protected edges), which exudation cannot remove and CalculiX refuses ("nonpositive jacobian").
+// Dropped, it changes nothing: its other faces lie in the boundary's plane and become boundary.
+template <class Cell>
+bool is_flat_boundary_cell(const C3t3& c3t3, const Cell& c) {
+  const Tr& tr = c3t3.triangulation();
+  std::array<Vec3, 4> p;
+  double longest = 0;
+  for (int k = 0; k < 4; ++k) {
+    const Point q = tr.geom_traits().construct_point_3_object()(tr.point(c, k));
+    p[std::size_t(k)] = Vec3(q.x(), q.y(), q.z());
+  }
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b) longest = std::max(longest, (p[a] - p[b]).norm());
+  // Rounding of the coordinates: 1e-12 of the longest edge's cube (the gear's: 1e-19).
+  if (std::abs(tet_volume(p[0], p[1], p[2], p[3])) > 1e-12 * longest * longest * longest) return false;
+  int boundary_faces = 0;
+  for (int k = 0; k < 4; ++k) boundary_faces += c3t3.is_in_complex(c->neighbor(k)) ? 0 : 1;
+  return boundary_faces >= 2;
+}
+
 }  // namespace
 
 TetMesh tetrahedralise(const TriMesh& surface, const TetMeshOptions& o, const std::string& source) {
@@ -71,6 +93,10 @@ TetMesh tetrahedralise(const TriMesh& surface, const TetMeshOptions& o, const st
     return it->second;
   };
   for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c) {
+    if (is_flat_boundary_cell(c3t3, c)) {
+      ++out.dropped_boundary_slivers;
+      continue;
+    }
     Tet t{node(c->vertex(0)), node(c->vertex(1)), node(c->vertex(2)), node(c->vertex(3))};
     if (tet_volume(out.nodes[t[0]], out.nodes[t[1]], out.nodes[t[2]], out.nodes[t[3]]) < 0) std::swap(t[2], t[3]);
     out.tets.push_back(t);

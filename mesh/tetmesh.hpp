@@ -25,6 +25,8 @@ struct TetMesh {
   std::vector<Tet> tets;
   // Mesh edges on the protected sharp edges of the surface (node indices).
   std::vector<std::array<int, 2>> feature_edges;
+  // Cells of zero volume on a flat part of the surface that the mesher left and this dropped.
+  std::size_t dropped_boundary_slivers = 0;
 };
 
 // Meshes the solid bounded by `surface` (closed, outward). Deterministic: the same surface and

@@ -71,6 +71,7 @@ nlohmann::json write_fem_outputs(const std::vector<post::Grain>& grains, const m
       {"min_radius_ratio", q.min_radius_ratio},
       {"mean_radius_ratio", q.mean_radius_ratio},
       {"inverted_elements", q.inverted},
+      {"dropped_boundary_slivers", fill.mesh.dropped_boundary_slivers},
       {"mesh_volume_m3", mesh_volume},
       {"volume_error_rel", mesh_volume / die.after.volume_m3 - 1},
       {"mass_kg", mass},

@@ -49,6 +49,30 @@ TEST(AtomicFile, ReplacesOnlyWhenComplete) {
             1);
 }
 
+TEST(StagingFolder, ReplacesAnEarlierRunsFilesAndSubfolderWhole) {
+  // A second run into the same folder: its files replace the first's, its subfolder replaces the
+  // first's whole (a file only the first run wrote there is gone), other files stay.
+  test::TempDir dir;
+  const auto write = [&](const std::string& run, bool extra) {
+    diefill::StagingFolder out(dir.path());
+    std::filesystem::create_directories(out / "fem");
+    diefill::write_file_atomic(out / "report.json", run);
+    diefill::write_file_atomic(out.path() / "fem" / "fill.inp", run);
+    if (extra) diefill::write_file_atomic(out.path() / "fem" / "compaction.inp", run);
+    out.commit();
+  };
+  diefill::write_file_atomic(dir / "notes.txt", "the user's");
+  write("first", true);
+  write("second", false);
+  EXPECT_EQ(test::read_text(dir / "report.json"), "second");
+  EXPECT_EQ(test::read_text(dir.path() / "fem" / "fill.inp"), "second");
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "fem" / "compaction.inp"));
+  EXPECT_EQ(test::read_text(dir / "notes.txt"), "the user's");
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir.path())) ++entries;
+  EXPECT_EQ(entries, 3u) << "no staging or set-aside folder left behind";
+}
+
 TEST(InputError, NamesFileFieldAndRemedy) {
   const diefill::InputError e("scene.toml", "simulation.duration", "must be positive", "Give a duration in seconds");
   EXPECT_STREQ(e.what(), "scene.toml: simulation.duration: must be positive. Give a duration in seconds");

@@ -48,6 +48,13 @@ TEST_P(SharpFeatureDie, FillsWithNoGrainInsideTheDieSolid) {
   ASSERT_FALSE(run.interrupted);
   EXPECT_EQ(run.report["particles"]["lost"], 0) << d.name;
   EXPECT_GT(run.report["particles"]["in_cavity"].get<int>(), 20) << d.name << ": grains entered the features";
+  // The FEM hand-off meshes the features too, and CalculiX runs it (a flat sliver the mesher left
+  // on the gear's wall once stopped it: "nonpositive jacobian").
+  const nlohmann::json& fem = run.report["fem"];
+  EXPECT_EQ(fem["inverted_elements"].get<int>(), 0) << d.name;
+  EXPECT_GT(fem["min_dihedral_deg"].get<double>(), 1.0) << d.name;
+  EXPECT_NEAR(fem["volume_error_rel"].get<double>(), 0.0, 0.005) << d.name;
+  EXPECT_TRUE(fem.contains("compaction")) << d.name << ": " << run.report["stability"]["warnings"].dump();
 
   // The solid the grains meet near the die: the table (wider than the shoe's travel) less the cavity.
   const mesh::ExactSurface solid(mesh::tool_from_cavity(cavity, mesh::table_around(cavity, 0.1), d.name).mesh);
