@@ -57,6 +57,7 @@ int run_density(const DensityCommand& c) {
     FemSettings fem;
     fem.element_size_m = c.element_size_mm > 0 ? c.element_size_mm * 1e-3 : s.voxel_m;
     fem.sub_voxel_m = std::min(r_max, 0.25 * fem.element_size_m);  // half the largest grain diameter, as the pipeline
+    fem.averaging_width_m = s.voxel_m;
     fem.quadratic = c.elements == "quadratic";
     report["fem"] = write_fem_outputs(grains, die, walls, material_density, result.stats.mass_kg, fem, out.path());
   }

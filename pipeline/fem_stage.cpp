@@ -52,7 +52,7 @@ nlohmann::json write_fem_outputs(const std::vector<post::Grain>& grains, const m
   const mesh::TetQuality q = mesh::tet_quality(tets);
   const post::CavityShape cavity{[&](const post::Vec3& p) { return walls.signed_distance(p); }, die.after.bbox.lo,
                                  post::Vec3(die.after.bbox.hi.x(), die.after.bbox.hi.y(), die.table_z)};
-  const post::FemFill fill = post::fill_elements(std::move(tets), grains, cavity, s.sub_voxel_m, material_density);
+  const post::FemFill fill = post::fill_elements(std::move(tets), grains, cavity, s.sub_voxel_m, s.averaging_width_m, material_density);
   const fs::path fem = dir / "fem";
   fs::create_directories(fem);
   post::write_fem(fill, s.quadratic, fmt::format("diefill fill of {} ({})", die.name, die.source), fem);
@@ -66,6 +66,7 @@ nlohmann::json write_fem_outputs(const std::vector<post::Grain>& grains, const m
       {"nodes", s.quadratic ? post::quadratic(fill).nodes.size() : fill.mesh.nodes.size()},
       {"element_size_m", s.element_size_m},
       {"sub_voxel_m", fill.sub_voxel_m},
+      {"averaging_width_m", fill.averaging_width_m},
       {"min_dihedral_deg", q.min_dihedral_deg},
       {"max_dihedral_deg", q.max_dihedral_deg},
       {"min_radius_ratio", q.min_radius_ratio},

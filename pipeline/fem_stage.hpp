@@ -15,6 +15,7 @@ namespace app {
 struct FemSettings {
   double element_size_m = 1.6e-3;
   double sub_voxel_m = 0.2e-3;     // the exact binning the elements' values are integrated from
+  double averaging_width_m = 0;    // each sub-voxel averaged over a cube this wide (post::fill_elements)
   bool quadratic = false;          // C3D10 instead of C3D4
   bool compaction = true;          // run the CalculiX example (a warning when ccx is missing)
 };

@@ -46,6 +46,7 @@ nlohmann::json write_fem_section(const FillRecord& r, const nlohmann::json& fill
   FemSettings settings;
   settings.element_size_m = r.scene.fem_element_size > 0 ? r.scene.fem_element_size : fill.at("voxel_m").get<double>();
   settings.sub_voxel_m = std::min(0.5 * r.grains.diameter, 0.25 * settings.element_size_m);
+  settings.averaging_width_m = fill.at("voxel_m").get<double>();  // the density field's scale
   settings.quadratic = r.scene.fem_elements == "quadratic";
   settings.compaction = r.scene.fem_compaction == "calculix";
   const double density = r.walls.spec.materials[std::size_t(r.walls.powder)].density;

@@ -79,6 +79,34 @@ std::vector<Overlap> overlaps(const Tet& t, const VoxelGrid& g) {
   return out;
 }
 
+// The mean over the cube of (2 k + 1)³ voxels centred on each voxel (separable running sums; the
+// part of a cube past the grid's edge counts as empty: the grid reaches a grain past the cavity).
+std::vector<double> box_average(const VoxelGrid& g, std::vector<double> values, int k) {
+  if (k <= 0) return values;
+  const std::array<int, 3> n = {g.nx, g.ny, g.nz};
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<double> out(values.size(), 0.0);
+    for (int i = 0; i < g.nx; ++i)
+      for (int j = 0; j < g.ny; ++j)
+        for (int l = 0; l < g.nz; ++l) {
+          std::array<int, 3> c = {i, j, l};
+          double sum = 0;
+          const int at = c[axis];
+          for (int m = std::max(0, at - k); m <= std::min(n[axis] - 1, at + k); ++m) {
+            c[axis] = m;
+            sum += values[g.index(c[0], c[1], c[2])];
+          }
+          out[g.index(i, j, l)] = sum / (2 * k + 1);
+        }
+    values.swap(out);
+  }
+  return values;
+}
+
+FemFill share_voxels(mesh::TetMesh m, const VoxelGrid& grid, const std::vector<double>& solid,
+                     const std::vector<double>& averaged_solid, const std::vector<double>& cavity_fraction,
+                     double material_density);
+
 }  // namespace
 
 double tet_box_overlap(const std::array<Vec3, 4>& tet, const Vec3& lo, const Vec3& hi) {
@@ -96,7 +124,7 @@ double tet_box_overlap(const std::array<Vec3, 4>& tet, const Vec3& lo, const Vec
 }
 
 FemFill fill_elements(mesh::TetMesh m, const std::vector<Grain>& grains, const CavityShape& cavity, double sub_voxel,
-                      double material_density) {
+                      double averaging_width, double material_density) {
   // Every grain whole, up to the table, whose plane is a voxel face (grain volume above it is
   // not in the cavity).
   double reach = 0;
@@ -106,12 +134,21 @@ FemFill fill_elements(mesh::TetMesh m, const std::vector<Grain>& grains, const C
   const VoxelGrid grid = grid_covering(lo, hi, sub_voxel, Vec3(0.5 * (lo.x() + hi.x()), 0.5 * (lo.y() + hi.y()), hi.z()));
   std::vector<double> solid;
   bin_exact(grains, grid, solid);
-  const CavityVolumes fractions = cavity_fractions(grid, cavity.distance, cavity.lo, cavity.hi, 3);
-  return share_voxels(std::move(m), grid, solid, fractions.fraction, material_density);
+  std::vector<double> cavity_fraction = cavity_fractions(grid, cavity.distance, cavity.lo, cavity.hi, 3).fraction;
+  const int half_window = int(std::lround(0.5 * averaging_width / sub_voxel));
+  FemFill f = share_voxels(std::move(m), grid, solid, box_average(grid, solid, half_window),
+                           box_average(grid, cavity_fraction, half_window), material_density);
+  f.averaging_width_m = (2 * half_window + 1) * sub_voxel;
+  return f;
 }
 
+namespace {
+
+// FemFill from a binned field: `solid` [m³] per voxel of `grid` (shared among the elements and
+// conserved), and the averaged solid and cavity fraction each element's ratio is taken of.
 FemFill share_voxels(mesh::TetMesh m, const VoxelGrid& grid, const std::vector<double>& solid,
-                     const std::vector<double>& cavity_fraction, double material_density) {
+                     const std::vector<double>& averaged_solid, const std::vector<double>& cavity_fraction,
+                     double material_density) {
   FemFill f;
   f.sub_voxel_m = grid.voxel;
   f.material_density = material_density;
@@ -137,7 +174,7 @@ FemFill share_voxels(mesh::TetMesh m, const VoxelGrid& grid, const std::vector<d
     double solid_share = 0, cavity_share = 0;
     for (const Overlap& o : shares[e]) {
       const double part = o.volume / covered[o.voxel];
-      solid_share += solid[o.voxel] * part;
+      solid_share += averaged_solid[o.voxel] * part;
       cavity_share += cavity_fraction[o.voxel] * voxel_volume * part;
     }
     f.element_fraction[e] = cavity_share > 0 ? solid_share / cavity_share : 0.0;
@@ -158,6 +195,8 @@ FemFill share_voxels(mesh::TetMesh m, const VoxelGrid& grid, const std::vector<d
   f.node_fraction = average_to_nodes(f.mesh, f.element_fraction, f.element_volume);
   return f;
 }
+
+}  // namespace
 
 std::vector<double> average_to_nodes(const mesh::TetMesh& m, const std::vector<double>& value,
                                      const std::vector<double>& volume) {

@@ -143,7 +143,7 @@ TEST(FemFill, KeepsALatticeFlatUpToTheWallsAndConservesItsVolume) {
   const mesh::WallField walls = die.sdf.wall_field(die.solid);
   const post::CavityShape cavity{[&](const Vec3& p) { return walls.signed_distance(p); }, die.after.bbox.lo,
                                  Vec3(die.after.bbox.hi.x(), die.after.bbox.hi.y(), die.table_z)};
-  const post::FemFill f = post::fill_elements(ring_mesh(), grains, cavity, 0.2e-3, 7800);
+  const post::FemFill f = post::fill_elements(ring_mesh(), grains, cavity, 0.2e-3, 0.6e-3, 7800);
   // Binning is exact to 1e-9 of a sphere per voxel it touches (postprocess/sphere_box.hpp).
   EXPECT_NEAR(f.binned_solid_m3 / below_table, 1.0, 1e-7);
   EXPECT_NEAR(f.solid_volume_m3 / f.binned_solid_m3, 1.0, 1e-12);

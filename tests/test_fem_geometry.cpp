@@ -90,7 +90,7 @@ TEST(FemFill, SharesEachGrainAmongTheElementsItOverlaps) {
   const double r = 0.3e-3, grain_volume = 4.0 / 3.0 * M_PI * r * r * r;
   const post::CavityShape cube{[](const Vec3& p) { return std::min(p.minCoeff(), 1e-3 - p.maxCoeff()); }, Vec3::Zero(),
                                Vec3::Constant(1e-3)};
-  const post::FemFill f = post::fill_elements(m, {{Vec3::Constant(0.5e-3), r, 1.0}}, cube, 0.05e-3, 7800);
+  const post::FemFill f = post::fill_elements(m, {{Vec3::Constant(0.5e-3), r, 1.0}}, cube, 0.05e-3, 0.0, 7800);
   // Binning is exact to 1e-9 of the sphere per voxel (postprocess/sphere_box.hpp), over the
   // thousand voxels it touches; sharing the binned volume among the elements adds only rounding.
   EXPECT_NEAR(f.binned_solid_m3, grain_volume, 1e-6 * grain_volume);
