@@ -120,8 +120,8 @@ KeyTable<P> make_pipeline_keys() {
                      "the smoothed field's Gaussian width and voxel; 0: half a grain diameter", &P::density_smoothed_width));
   k.push_back(number("fem", "element_size", "m", {0, metre_range_hi}, run,
                      "the tetrahedra's largest edge in fem/fill.inp; 0: the density voxel", &P::fem_element_size));
-  k.push_back(text("fem", "elements", KeyType::choice, {"linear", "quadratic"}, run,
-                   "C3D4, or C3D10 with a node on every edge", &P::fem_elements));
+  k.push_back(text("fem", "elements", KeyType::choice, {"linear", "quadratic", "none"}, run,
+                   "C3D4, C3D10 with a node on every edge, or none: no FEM hand-off", &P::fem_elements));
   k.push_back(text("fem", "compaction", KeyType::choice, {"calculix", "none"}, run,
                    "the worked example: the fill pressed by a punch in CalculiX (fem/compaction.*)", &P::fem_compaction));
   k.push_back(text("output", "directory", KeyType::text, {}, nothing, "each die writes into DIRECTORY/<die name>/ (relative "

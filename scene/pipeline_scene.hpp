@@ -52,7 +52,7 @@ struct PipelineScene {
   double density_smoothed_width = 0;  // [m]; 0: half a grain diameter
   // [fem] the hand-off to compaction FEM (docs/INTERFACE.md, "FEM hand-off")
   double fem_element_size = 0;        // [m]; 0: the density voxel
-  std::string fem_elements = "linear";        // "linear" (C3D4) | "quadratic" (C3D10)
+  std::string fem_elements = "linear";        // "linear" (C3D4) | "quadratic" (C3D10) | "none" (no hand-off)
   std::string fem_compaction = "calculix";    // "calculix": run the worked example | "none"
   // [output]
   std::filesystem::path out = "out";

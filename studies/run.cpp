@@ -45,6 +45,9 @@ int run_study(const StudyRequest& c) {
     throw diefill::InputError("", "NAME", fmt::format("there is no study \"{}\"", c.name), "Choose one of: " + known);
   }
   PipelineScene scene = load_pipeline_scene(c.scene, c.overrides);
+  // The studies read fills and flows, not FEM decks: no hand-off, whose mesh and CalculiX run
+  // would add seconds to each of their many runs.
+  scene.fem_elements = "none";
   if (c.threads) scene.threads = *c.threads;
   if (c.seed) scene.seed = *c.seed;
   if (scene.threads > 0) omp_set_num_threads(scene.threads);
