@@ -81,12 +81,18 @@ std::string mesh_deck(const FemFill& f, const Elements& el, const QuadraticTets*
   return out;
 }
 
+// Every node's solid fraction, as an initial condition of the given type.
+std::string node_fractions(const std::string& type, const Elements& el) {
+  std::string out = "*INITIAL CONDITIONS, TYPE=" + type + "\n";
+  for (std::size_t n = 0; n < el.nodes->size(); ++n) out += fmt::format("{}, {:.9g}\n", n + 1, (*el.node_fraction)[n]);
+  return out;
+}
+
 std::string abaqus_state(const FemFill& f, const Elements& el) {
   std::string out = "** Abaqus: the fill's solid fraction as field variable 1 at every node (a DPC or Cam-Clay model\n"
                     "** whose parameters are tabulated against it with DEPENDENCIES=1 picks it up), and per element\n"
                     "** solution-dependent state variables 1 (solid fraction) and 2 (density, kg/m^3): *DEPVAR 2.\n";
-  out += "*INITIAL CONDITIONS, TYPE=FIELD, VARIABLE=1\n";
-  for (std::size_t n = 0; n < el.nodes->size(); ++n) out += fmt::format("{}, {:.9g}\n", n + 1, (*el.node_fraction)[n]);
+  out += node_fractions("FIELD, VARIABLE=1", el);
   out += "*INITIAL CONDITIONS, TYPE=SOLUTION\n";
   for (std::size_t e = 0; e < f.element_fraction.size(); ++e)
     out += fmt::format("{}, {:.9g}, {:.9g}\n", e + 1, f.element_fraction[e], f.element_fraction[e] * f.material_density);
@@ -98,8 +104,7 @@ std::string calculix_state(const FemFill& f, const Elements& el) {
                     "** temperature, for material data tabulated against temperature (give no *EXPANSION), and per\n"
                     "** element and integration point state variables 1 (solid fraction) and 2 (density, kg/m^3):\n"
                     "** the material needs *DEPVAR 2 and must come before this file.\n";
-  out += "*INITIAL CONDITIONS, TYPE=TEMPERATURE\n";
-  for (std::size_t n = 0; n < el.nodes->size(); ++n) out += fmt::format("{}, {:.9g}\n", n + 1, (*el.node_fraction)[n]);
+  out += node_fractions("TEMPERATURE", el);
   out += "*INITIAL CONDITIONS, TYPE=SOLUTION\n";
   for (std::size_t e = 0; e < f.element_fraction.size(); ++e)
     for (int ip = 1; ip <= el.integration_points; ++ip)
