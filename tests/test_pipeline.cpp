@@ -60,6 +60,8 @@ const nlohmann::json& run(const std::string& die, double speed, std::uint64_t se
                                         "output.directory=" + (suite_out() / folder).string()};
   std::stringstream list(grains);
   for (std::string item; std::getline(list, item, ' ');) overrides.push_back(item);
+  // The FEM hand-off is tested on the plain runs; the variants leave it out (about 2 s each).
+  if (grains != coarse) overrides.push_back("fem.elements=none");
   app::PipelineScene scene = app::load_pipeline_scene(std::nullopt, overrides);
   const app::DieRun r = app::run_die_fill(scene, bundled_die(die), false);
   EXPECT_FALSE(r.interrupted);
@@ -368,7 +370,8 @@ TEST(Pipeline, SweepRunsEachCaseAsItsSingleRun) {
   const fs::path base = suite_out() / "sweep";
   const auto load = [&](const std::vector<std::string>& more) {
     std::vector<std::string> overrides = {"simulation.seed=1", "output.directory=" + base.string(),
-                                          "output.cache=" + (suite_out() / "a" / ".cache").string(), coarse};
+                                          "output.cache=" + (suite_out() / "a" / ".cache").string(), coarse,
+                                          "fem.elements=none"};
     overrides.insert(overrides.end(), more.begin(), more.end());
     app::PipelineScene scene = app::load_pipeline_scene(std::nullopt, overrides);
     scene.die = bundled_die("ring");
