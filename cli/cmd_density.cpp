@@ -54,10 +54,7 @@ int run_density(const DensityCommand& c) {
                                         {"coarse_graining", c.coarse_graining}}},
                            {"fill", statistics_json(result.stats)}};
   if (c.fem) {
-    FemSettings fem;
-    fem.element_size_m = c.element_size_mm > 0 ? c.element_size_mm * 1e-3 : s.voxel_m;
-    fem.sub_voxel_m = std::min(r_max, 0.25 * fem.element_size_m);  // half the largest grain diameter, as the pipeline
-    fem.averaging_width_m = s.voxel_m;
+    FemSettings fem = fem_settings(2 * r_max, s.voxel_m, c.element_size_mm * 1e-3);
     fem.quadratic = c.elements == "quadratic";
     report["fem"] = write_fem_outputs(grains, die, walls, material_density, result.stats.mass_kg, fem, out.path());
   }

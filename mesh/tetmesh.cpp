@@ -10,7 +10,6 @@
 #include <CGAL/Polyhedral_mesh_domain_with_features_3.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/make_mesh_3.h>
-#include <fmt/core.h>
 
 #include <map>
 
@@ -39,8 +38,8 @@ SurfaceMesh surface_mesh(const TriMesh& m) {
   CGAL::Polygon_mesh_processing::polygon_soup_to_polygon_mesh(points, faces, sm);
   return sm;
 }
-// A cell whose four vertices lie in one plane (to rounding; exactly, they need not) with two or more faces on the boundary:
-// a sliver Mesh_3 can leave lying on a flat part of the surface (on the gear die's wall, between
+// A cell whose four vertices lie in one plane (to rounding; exactly, they need not) with two or
+// more faces on the boundary: a sliver Mesh_3 can leave lying on a flat part of the surface (on the gear die's wall, between
 // protected edges), which exudation cannot remove and CalculiX refuses ("nonpositive jacobian").
 // Dropped, it changes nothing: its other faces lie in the boundary's plane and become boundary.
 template <class Cell>

@@ -46,6 +46,14 @@ nlohmann::json compaction_example(const post::FemFill& fill, const fs::path& dir
 
 }  // namespace
 
+FemSettings fem_settings(double grain_diameter, double density_voxel, double element_size) {
+  FemSettings s;
+  s.element_size_m = element_size > 0 ? element_size : density_voxel;
+  s.sub_voxel_m = std::min(0.5 * grain_diameter, 0.25 * s.element_size_m);
+  s.averaging_width_m = density_voxel;
+  return s;
+}
+
 nlohmann::json write_fem_outputs(const std::vector<post::Grain>& grains, const mesh::PreparedDie& die, const mesh::WallField& walls,
                                  double material_density, double mass_in_cavity_kg, const FemSettings& s, const fs::path& dir) {
   mesh::TetMesh tets = mesh::tetrahedralise(die.cavity, {s.element_size_m, s.element_size_m / 200, 60}, die.source);
@@ -55,7 +63,7 @@ nlohmann::json write_fem_outputs(const std::vector<post::Grain>& grains, const m
   const post::FemFill fill = post::fill_elements(std::move(tets), grains, cavity, s.sub_voxel_m, s.averaging_width_m, material_density);
   const fs::path fem = dir / "fem";
   fs::create_directories(fem);
-  post::write_fem(fill, s.quadratic, fmt::format("diefill fill of {} ({})", die.name, die.source), fem);
+  const std::size_t nodes = post::write_fem(fill, s.quadratic, fmt::format("diefill fill of {} ({})", die.name, die.source), fem);
   const double mesh_volume = std::accumulate(fill.element_volume.begin(), fill.element_volume.end(), 0.0);
   const double mass = fill.solid_volume_m3 * material_density;
   const auto [lo, hi] = std::minmax_element(fill.element_fraction.begin(), fill.element_fraction.end());
@@ -63,7 +71,7 @@ nlohmann::json write_fem_outputs(const std::vector<post::Grain>& grains, const m
       {"files", {"fem/fill.inp", "fem/fill_abaqus.inp", "fem/fill_calculix.inp", "fem/fill.vtu"}},
       {"element_type", s.quadratic ? "C3D10" : "C3D4"},
       {"elements", fill.mesh.tets.size()},
-      {"nodes", s.quadratic ? post::quadratic(fill).nodes.size() : fill.mesh.nodes.size()},
+      {"nodes", nodes},
       {"element_size_m", s.element_size_m},
       {"sub_voxel_m", fill.sub_voxel_m},
       {"averaging_width_m", fill.averaging_width_m},

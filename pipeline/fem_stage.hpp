@@ -20,6 +20,11 @@ struct FemSettings {
   bool compaction = true;          // run the CalculiX example (a warning when ccx is missing)
 };
 
+// The settings for grains of `grain_diameter` whose density field has voxels of `density_voxel`:
+// elements of `element_size` (0: the density voxel), sub-voxels of half a grain diameter (at most
+// a quarter element), averaged over the density voxel (the field's scale).
+FemSettings fem_settings(double grain_diameter, double density_voxel, double element_size);
+
 // Writes `dir`/fem/ and returns the report's `fem` section; `mass_in_cavity_kg` is the density
 // field's (fill.mass_kg), which the elements' mass is checked against.
 nlohmann::json write_fem_outputs(const std::vector<post::Grain>& cavity_grains, const mesh::PreparedDie& die,

@@ -43,10 +43,7 @@ nlohmann::json write_density_field(const FillRecord& r, const fs::path& dir) {
 // The FEM hand-off (fem/), on elements as large as the density voxels unless the scene says.
 nlohmann::json write_fem_section(const FillRecord& r, const nlohmann::json& fill, const fs::path& dir) {
   if (r.census.cavity.empty() || r.scene.fem_elements == "none") return nullptr;
-  FemSettings settings;
-  settings.element_size_m = r.scene.fem_element_size > 0 ? r.scene.fem_element_size : fill.at("voxel_m").get<double>();
-  settings.sub_voxel_m = std::min(0.5 * r.grains.diameter, 0.25 * settings.element_size_m);
-  settings.averaging_width_m = fill.at("voxel_m").get<double>();  // the density field's scale
+  FemSettings settings = fem_settings(r.grains.diameter, fill.at("voxel_m").get<double>(), r.scene.fem_element_size);
   settings.quadratic = r.scene.fem_elements == "quadratic";
   settings.compaction = r.scene.fem_compaction == "calculix";
   const double density = r.walls.spec.materials[std::size_t(r.walls.powder)].density;

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
-#include <map>
 
 namespace post {
 
@@ -11,7 +9,7 @@ namespace {
 
 using Tet = std::array<Vec3, 4>;
 
-double volume(const Tet& t) { return std::abs((t[1] - t[0]).cross(t[2] - t[0]).dot(t[3] - t[0])) / 6.0; }
+double volume(const Tet& t) { return std::abs(mesh::tet_volume(t[0], t[1], t[2], t[3])); }
 
 // A triangular prism (a0 a1 a2 below, b0 b1 b2 above, ai joined to bi) as three tetrahedra.
 void add_prism(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0, const Vec3& b1, const Vec3& b2,
@@ -79,7 +77,7 @@ std::vector<Overlap> overlaps(const Tet& t, const VoxelGrid& g) {
   return out;
 }
 
-// The mean over the cube of (2 k + 1)³ voxels centred on each voxel (separable running sums; the
+// The mean over the cube of (2 k + 1)³ voxels centred on each voxel (one axis at a time; the
 // part of a cube past the grid's edge counts as empty: the grid reaches a grain past the cavity).
 std::vector<double> box_average(const VoxelGrid& g, std::vector<double> values, int k) {
   if (k <= 0) return values;
@@ -102,47 +100,6 @@ std::vector<double> box_average(const VoxelGrid& g, std::vector<double> values, 
   }
   return values;
 }
-
-FemFill share_voxels(mesh::TetMesh m, const VoxelGrid& grid, const std::vector<double>& solid,
-                     const std::vector<double>& averaged_solid, const std::vector<double>& cavity_fraction,
-                     double material_density);
-
-}  // namespace
-
-double tet_box_overlap(const std::array<Vec3, 4>& tet, const Vec3& lo, const Vec3& hi) {
-  std::vector<Tet> pieces = {tet}, next;
-  for (int axis = 0; axis < 3; ++axis)
-    for (const auto& [bound, side] : {std::pair{hi[axis], 1.0}, std::pair{lo[axis], -1.0}}) {
-      next.clear();
-      for (const Tet& t : pieces) clip(t, axis, bound, side, next);
-      pieces.swap(next);
-      if (pieces.empty()) return 0.0;
-    }
-  double v = 0;
-  for (const Tet& t : pieces) v += volume(t);
-  return v;
-}
-
-FemFill fill_elements(mesh::TetMesh m, const std::vector<Grain>& grains, const CavityShape& cavity, double sub_voxel,
-                      double averaging_width, double material_density) {
-  // Every grain whole, up to the table, whose plane is a voxel face (grain volume above it is
-  // not in the cavity).
-  double reach = 0;
-  for (const Grain& g : grains) reach = std::max(reach, g.radius);
-  const Vec3 lo = cavity.lo - Vec3::Constant(reach);
-  const Vec3 hi(cavity.hi.x() + reach, cavity.hi.y() + reach, cavity.hi.z());
-  const VoxelGrid grid = grid_covering(lo, hi, sub_voxel, Vec3(0.5 * (lo.x() + hi.x()), 0.5 * (lo.y() + hi.y()), hi.z()));
-  std::vector<double> solid;
-  bin_exact(grains, grid, solid);
-  std::vector<double> cavity_fraction = cavity_fractions(grid, cavity.distance, cavity.lo, cavity.hi, 3).fraction;
-  const int half_window = int(std::lround(0.5 * averaging_width / sub_voxel));
-  FemFill f = share_voxels(std::move(m), grid, solid, box_average(grid, solid, half_window),
-                           box_average(grid, cavity_fraction, half_window), material_density);
-  f.averaging_width_m = (2 * half_window + 1) * sub_voxel;
-  return f;
-}
-
-namespace {
 
 // FemFill from a binned field: `solid` [m³] per voxel of `grid` (shared among the elements and
 // conserved), and the averaged solid and cavity fraction each element's ratio is taken of.
@@ -180,7 +137,7 @@ FemFill share_voxels(mesh::TetMesh m, const VoxelGrid& grid, const std::vector<d
     f.element_fraction[e] = cavity_share > 0 ? solid_share / cavity_share : 0.0;
   }
   // The grains' volume in the cavity (voxels no element reaches included), conserved exactly by
-  // one scale over all elements: the mesh's volume differs from the cavity's by its chords.
+  // one scale over all elements (fill_elements in fem.hpp says what it takes back).
   for (std::size_t n = 0; n < grid.size(); ++n) {
     f.binned_solid_m3 += solid[n];
     if (covered[n] <= 0) f.outside_mesh_m3 += solid[n];
@@ -197,6 +154,39 @@ FemFill share_voxels(mesh::TetMesh m, const VoxelGrid& grid, const std::vector<d
 }
 
 }  // namespace
+
+double tet_box_overlap(const std::array<Vec3, 4>& tet, const Vec3& lo, const Vec3& hi) {
+  std::vector<Tet> pieces = {tet}, next;
+  for (int axis = 0; axis < 3; ++axis)
+    for (const auto& [bound, side] : {std::pair{hi[axis], 1.0}, std::pair{lo[axis], -1.0}}) {
+      next.clear();
+      for (const Tet& t : pieces) clip(t, axis, bound, side, next);
+      pieces.swap(next);
+      if (pieces.empty()) return 0.0;
+    }
+  double v = 0;
+  for (const Tet& t : pieces) v += volume(t);
+  return v;
+}
+
+FemFill fill_elements(mesh::TetMesh m, const std::vector<Grain>& grains, const CavityShape& cavity, double sub_voxel,
+                      double averaging_width, double material_density) {
+  // Every grain whole, up to the table, whose plane is a voxel face (grain volume above it is
+  // not in the cavity).
+  double reach = 0;
+  for (const Grain& g : grains) reach = std::max(reach, g.radius);
+  const Vec3 lo = cavity.lo - Vec3::Constant(reach);
+  const Vec3 hi(cavity.hi.x() + reach, cavity.hi.y() + reach, cavity.hi.z());
+  const VoxelGrid grid = grid_covering(lo, hi, sub_voxel, Vec3(0.5 * (lo.x() + hi.x()), 0.5 * (lo.y() + hi.y()), hi.z()));
+  std::vector<double> solid;
+  bin_exact(grains, grid, solid);
+  std::vector<double> cavity_fraction = cavity_fractions(grid, cavity.distance, cavity.lo, cavity.hi, 3).fraction;
+  const int half_window = int(std::lround(0.5 * averaging_width / sub_voxel));
+  FemFill f = share_voxels(std::move(m), grid, solid, box_average(grid, solid, half_window),
+                           box_average(grid, cavity_fraction, half_window), material_density);
+  f.averaging_width_m = (2 * half_window + 1) * sub_voxel;
+  return f;
+}
 
 std::vector<double> average_to_nodes(const mesh::TetMesh& m, const std::vector<double>& value,
                                      const std::vector<double>& volume) {

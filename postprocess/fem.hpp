@@ -64,10 +64,6 @@ struct QuadraticTets {
 };
 QuadraticTets quadratic(const FemFill& fill);
 
-}  // namespace post
-
-namespace post {
-
 // The boundary's faces (corner nodes, 0-based) by their outward normals: TABLE (on the table's
 // plane, where a top punch acts), FLOOR (facing down by more than 45°: a bottom punch or the die
 // floor) and WALLS (the rest). fill.inp's node sets of the same names hold their nodes.
@@ -89,6 +85,7 @@ std::vector<double> average_to_nodes(const mesh::TetMesh& mesh, const std::vecto
 //   fill_calculix.inp  the same state in CalculiX' syntax (per integration point) and the
 //                      nodes' solid fraction as their initial temperature;
 //   fill.vtu           the elements with both as cell and point data (ParaView, meshio).
-void write_fem(const FemFill& fill, bool quadratic, const std::string& heading, const std::filesystem::path& dir);
+// Returns the number of nodes written (with the middle nodes of quadratic elements).
+std::size_t write_fem(const FemFill& fill, bool quadratic, const std::string& heading, const std::filesystem::path& dir);
 
 }  // namespace post

@@ -174,7 +174,7 @@ BoundarySets boundary_sets(const mesh::TetMesh& m, double table_z) {
   return sets;
 }
 
-void write_fem(const FemFill& f, bool quadratic_elements, const std::string& heading, const std::filesystem::path& dir) {
+std::size_t write_fem(const FemFill& f, bool quadratic_elements, const std::string& heading, const std::filesystem::path& dir) {
   double table_z = -std::numeric_limits<double>::infinity();
   for (const Vec3& p : f.mesh.nodes) table_z = std::max(table_z, p.z());
   const QuadraticTets q = quadratic_elements ? quadratic(f) : QuadraticTets{};
@@ -183,6 +183,7 @@ void write_fem(const FemFill& f, bool quadratic_elements, const std::string& hea
   diefill::write_file_atomic(dir / "fill_abaqus.inp", abaqus_state(f, el));
   diefill::write_file_atomic(dir / "fill_calculix.inp", calculix_state(f, el));
   diefill::write_file_atomic(dir / "fill.vtu", vtu(f, el));
+  return el.nodes->size();
 }
 
 }  // namespace post
