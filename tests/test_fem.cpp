@@ -70,8 +70,9 @@ TEST(TetMesh, RingIsMeshedWithItsVolumeAndItsRimsOnMeshEdges) {
               q.min_radius_ratio, q.mean_radius_ratio);
   EXPECT_EQ(q.inverted, 0u);
   EXPECT_NEAR(volume / expected, 1.0, 0.005);
-  // CGAL's mesher after perturbation and exudation: the manual's figures give smallest dihedral
-  // angles above 10° (CGAL 5.5 Mesh_3 user manual, "Optimization" section).
+  // After perturbation and exudation the smallest dihedral angle should clear 10°, the figure
+  // usually quoted for CGAL's sliver exudation (a bound this project sets; it was not checked
+  // against CGAL's manual here). Measured: 12.0°.
   EXPECT_GT(q.min_dihedral_deg, 10.0);
   EXPECT_GT(q.min_radius_ratio, 0.1);
 
