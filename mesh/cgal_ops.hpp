@@ -1,6 +1,8 @@
 #pragma once
 // Internal to the mesh module: CGAL operations split into their own translation units so that
 // the heavy headers compile in parallel on a 2-core machine.
+#include <functional>
+
 #include "mesh/trimesh.hpp"
 
 namespace mesh::detail {
@@ -15,6 +17,9 @@ TriMesh alpha_wrap(const TriMesh& soup, double alpha, double offset);
 // (inner lobes of a fold) bound no part of it, wherever they lie.
 enum class Samples { all, outside_target };
 double max_distance(const TriMesh& from, const TriMesh& to, Samples samples = Samples::all);
+// The same over the sample points (with their face's unit normal) that `counts` accepts.
+using SampleFilter = std::function<bool(const Vec3& point, const Vec3& unit_normal)>;
+double max_distance(const TriMesh& from, const TriMesh& to, const SampleFilter& counts);
 
 // Pairs of intersecting triangles that share no vertex; 0 for a clean mesh.
 std::size_t count_self_intersections(const TriMesh& mesh);

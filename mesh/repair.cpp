@@ -3,6 +3,7 @@
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/border.h>
+#include <CGAL/Polygon_mesh_processing/connected_components.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/orientation.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
@@ -27,6 +28,7 @@
 #include "core/timer.hpp"
 #include "mesh/versions.hpp"
 #include "mesh/cgal_ops.hpp"
+#include "mesh/winding_solid.hpp"
 
 namespace mesh {
 
@@ -144,9 +146,124 @@ double mean_thickness(const TriMesh& mesh) {
 
 std::string mm(double metres) { return fmt::format("{:.4g} mm", metres * 1e3); }
 
+// Each edge-connected piece of a consistently oriented soup turned so that it encloses positive
+// volume about its own centroid: the winding number counts a piece exported inward as -1.
+TriMesh outward_pieces(SurfaceMesh sm) {
+  auto piece = sm.add_property_map<SurfaceMesh::Face_index, std::size_t>("f:piece").first;
+  const std::size_t pieces = PMP::connected_components(sm, piece);
+  std::vector<Vec3> sum(pieces, Vec3::Zero());
+  std::vector<double> count(pieces, 0.0), six_volume(pieces, 0.0);
+  auto position = [&](SurfaceMesh::Vertex_index v) {
+    const Point& p = sm.point(v);
+    return Vec3(p.x(), p.y(), p.z());
+  };
+  for (auto f : sm.faces())
+    for (auto v : CGAL::vertices_around_face(sm.halfedge(f), sm)) sum[piece[f]] += position(v), count[piece[f]] += 1;
+  for (auto f : sm.faces()) {
+    const Vec3 centre = sum[piece[f]] / count[piece[f]];
+    std::array<Vec3, 3> corner;
+    int k = 0;
+    for (auto v : CGAL::vertices_around_face(sm.halfedge(f), sm))
+      if (k < 3) corner[std::size_t(k++)] = position(v) - centre;
+    six_volume[piece[f]] += corner[0].dot(corner[1].cross(corner[2]));
+  }
+  TriMesh out = to_trimesh(sm);
+  std::size_t f = 0;
+  for (auto face : sm.faces()) {
+    if (six_volume[piece[face]] < 0) std::swap(out.triangles[f][1], out.triangles[f][2]);
+    ++f;
+  }
+  return out;
+}
+
+// The winding-number route is refused beyond this much ambiguous volume, as a share of the
+// solid: a crack or a small hole leaves a sliver of it, a missing face a region as large as the
+// part (docs/INTERFACE.md, "Mesh repair"). The project's choice, not a published bound.
+constexpr double max_ambiguous_share = 0.01;
+// Distance-band cells beyond which the winding-number re-mesh takes minutes on two cores.
+constexpr double max_winding_cells = 1.5e8;
+
 // Alpha wraps beyond this size take minutes on two cores (1.4 million triangles: 250 s); the user is asked to repair
 // the mesh or accept a coarser tolerance instead.
 constexpr double max_wrap_triangles = 3e5;
+
+// Step 6 of repair, first choice: the solid the surface's winding number encloses, re-meshed on
+// cells of the tolerance. Refused by name where that solid is undefined (too much ambiguous
+// volume); empty where re-meshing would cost too much or move the surface beyond the tolerance,
+// so that the alpha wrap is tried instead.
+std::optional<TriMesh> winding_number_solid(const SurfaceMesh& sm, const MeshReport& before,
+                                            const RepairOptions& options, const std::string& source,
+                                            const std::string& defect, RepairResult& result) {
+  const double cell = options.tolerance_m;
+  if (detail::winding_solid_cells(before.area_m2, cell) > max_winding_cells) return std::nullopt;
+  diefill::Stopwatch clock;
+  const TriMesh soup = outward_pieces(sm);
+  const detail::WindingSurvey survey = detail::survey_winding(soup);
+  if (survey.ambiguous_volume_m3 > max_ambiguous_share * survey.solid_volume_m3) {
+    const Box& b = survey.ambiguous_box;
+    throw InputError(source, "boundary edges",
+                     fmt::format("{}; the volume it encloses is undefined: its winding number is "
+                                 "neither near 0 nor near 1 in {:.4g} mm³ ({:.3g} % of the {:.4g} mm³ it "
+                                 "clearly encloses), within [{:.4g}, {:.4g}, {:.4g}] – [{:.4g}, {:.4g}, "
+                                 "{:.4g}] mm: an open face or a large hole",
+                                 defect, survey.ambiguous_volume_m3 * 1e9,
+                                 100 * survey.ambiguous_volume_m3 / survey.solid_volume_m3,
+                                 survey.solid_volume_m3 * 1e9, b.lo.x() * 1e3, b.lo.y() * 1e3,
+                                 b.lo.z() * 1e3, b.hi.x() * 1e3, b.hi.y() * 1e3, b.hi.z() * 1e3),
+                     "Close the mesh in CAD there");
+  }
+  detail::WindingSolid solid = detail::winding_solid(soup, cell);
+  diefill::log::debug("repair: winding-number solid ({} triangles, moved {}) in {:.2f} s",
+                      solid.mesh.triangles.size(), mm(solid.moved_m), clock.seconds());
+  if (solid.mesh.triangles.empty() || solid.moved_m > options.tolerance_m) return std::nullopt;
+  result.actions.push_back(fmt::format(
+      "{}: re-meshed as the solid its winding number encloses (cells of {}; ambiguous volume {:.4g} mm³, "
+      "{:.3g} % of the solid)",
+      defect, mm(cell), survey.ambiguous_volume_m3 * 1e9, 100 * survey.ambiguous_volume_m3 / survey.solid_volume_m3));
+  result.winding_moved_m = solid.moved_m;
+  return std::move(solid.mesh);
+}
+
+// Step 6 of repair, second choice: an alpha wrap within the tolerance (CGAL), refused where the
+// holes are wider than the wrapping ball, wrapping is not allowed, or it would cost too much.
+TriMesh alpha_wrapped(const TriMesh& input, const MeshReport& before, const RepairOptions& options,
+                      const std::string& source, const std::string& defect, bool closed,
+                      double largest_open_hole, RepairResult& result) {
+  diefill::Stopwatch clock;
+  const double alpha = 2.0 * options.tolerance_m;
+  const double offset = 0.25 * options.tolerance_m;
+  // A hole wider than the wrapping ball lets the wrap inside: it would return a thin sheet.
+  if (!closed && largest_open_hole > 2.0 * alpha)
+    throw InputError(source, "boundary edges",
+                     defect + fmt::format("; holes larger than {} are not filled",
+                                          mm(options.max_hole_m)),
+                     "Close the mesh in CAD, or raise the largest hole to fill (--max-hole)");
+  if (!options.allow_wrap)
+    throw InputError(source, "surface", defect,
+                     "Repair the mesh in CAD, or allow the alpha-wrap fallback");
+  // A wrap has about 2 A / alpha² triangles; beyond a few million it takes many minutes.
+  const double expected_triangles = 2.0 * before.area_m2 / (alpha * alpha);
+  if (expected_triangles > max_wrap_triangles)
+    throw InputError(source, "surface",
+                     fmt::format("{}, and wrapping it within the tolerance {} would take about "
+                                 "{:.3g} million triangles",
+                                 defect, mm(options.tolerance_m), expected_triangles / 1e6),
+                     "Repair the mesh in CAD, or raise the tolerance (--tolerance)");
+  TriMesh wrapped = detail::alpha_wrap(input, alpha, offset);
+  diefill::log::debug("repair: alpha wrap ({} triangles) done at {:.2f} s", wrapped.triangles.size(),
+                      clock.seconds());
+  if (wrapped.triangles.empty() || mean_thickness(wrapped) < 10.0 * offset)
+    throw InputError(source, "boundary edges",
+                     defect + "; it does not enclose a volume, and wrapping it within the "
+                              "tolerance " + mm(options.tolerance_m) + " gives only a thin sheet",
+                     fmt::format("Close the mesh in CAD, or raise the largest hole to fill "
+                                 "(--max-hole, now {})",
+                                 mm(options.max_hole_m)));
+  result.actions.push_back(fmt::format("{}: alpha-wrapped (alpha {}, offset {})", defect,
+                                       mm(alpha), mm(offset)));
+  result.wrapped = true;
+  return wrapped;
+}
 
 }  // namespace
 
@@ -298,7 +415,8 @@ RepairResult repair(const TriMesh& input, const RepairOptions& options, const st
   //    surface that stays on the outside; removing a fold does, and is measured.
   if (closed && self_intersecting) {
     detail::UnionResult united;
-    if (detail::union_of_shells(repaired, united)) {
+    // A fold removed by moving the surface beyond the tolerance is left to the winding number.
+    if (detail::union_of_shells(repaired, united) && united.moved_m <= options.tolerance_m) {
       if (united.empty_shells > 0)
         result.actions.push_back(fmt::format("dropped {} shell(s) enclosing no volume", united.empty_shells));
       result.actions.push_back(fmt::format("united {} intersecting shells (exact corefinement)", before.shells));
@@ -357,39 +475,10 @@ RepairResult repair(const TriMesh& input, const RepairOptions& options, const st
         parts.push_back(fmt::format("{} pairs of intersecting triangles", crossing));
       if (!parts.empty()) defect += " (" + fmt::format("{}", fmt::join(parts, "; ")) + ")";
     }
-    const double alpha = 2.0 * options.tolerance_m;
-    const double offset = 0.25 * options.tolerance_m;
-    // A hole wider than the wrapping ball lets the wrap inside: it would return a thin sheet.
-    if (!closed && largest_open_hole > 2.0 * alpha)
-      throw InputError(source, "boundary edges",
-                       defect + fmt::format("; holes larger than {} are not filled",
-                                            mm(options.max_hole_m)),
-                       "Close the mesh in CAD, or raise the largest hole to fill (--max-hole)");
-    if (!options.allow_wrap)
-      throw InputError(source, "surface", defect,
-                       "Repair the mesh in CAD, or allow the alpha-wrap fallback");
-    // A wrap has about 2 A / alpha² triangles; beyond a few million it takes many minutes.
-    const double expected_triangles = 2.0 * before.area_m2 / (alpha * alpha);
-    if (expected_triangles > max_wrap_triangles)
-      throw InputError(source, "surface",
-                       fmt::format("{}, and wrapping it within the tolerance {} would take about "
-                                   "{:.3g} million triangles",
-                                   defect, mm(options.tolerance_m), expected_triangles / 1e6),
-                       "Repair the mesh in CAD, or raise the tolerance (--tolerance)");
-    TriMesh wrapped = detail::alpha_wrap(input, alpha, offset);
-    diefill::log::debug("repair: alpha wrap ({} triangles) done at {:.2f} s", wrapped.triangles.size(),
-                        clock.seconds());
-    if (wrapped.triangles.empty() || mean_thickness(wrapped) < 10.0 * offset)
-      throw InputError(source, "boundary edges",
-                       defect + "; it does not enclose a volume, and wrapping it within the "
-                                "tolerance " + mm(options.tolerance_m) + " gives only a thin sheet",
-                       fmt::format("Close the mesh in CAD, or raise the largest hole to fill "
-                                   "(--max-hole, now {})",
-                                   mm(options.max_hole_m)));
-    result.actions.push_back(fmt::format("{}: alpha-wrapped (alpha {}, offset {})", defect,
-                                         mm(alpha), mm(offset)));
-    result.wrapped = true;
-    repaired = std::move(wrapped);
+    if (std::optional<TriMesh> solid = winding_number_solid(sm, before, options, source, defect, result))
+      repaired = std::move(*solid);
+    else
+      repaired = alpha_wrapped(input, before, options, source, defect, closed, largest_open_hole, result);
     geometry_changed = true;
   }
 
@@ -399,7 +488,9 @@ RepairResult repair(const TriMesh& input, const RepairOptions& options, const st
     // The union removes faces buried in the solid (a shell inside another, inner lobes), which
     // measured against the result would read as moved by their depth: what it moved is what
     // removing folds moved. Hole patches and a wrap are measured against the input.
-    result.hausdorff_m = union_moved_m ? *union_moved_m : detail::max_distance(input, repaired);
+    result.hausdorff_m = union_moved_m ? *union_moved_m
+                         : result.winding_moved_m ? *result.winding_moved_m
+                                                  : detail::max_distance(input, repaired);
     if (result.hausdorff_m > options.tolerance_m)
       throw InputError(source, "tolerance",
                        fmt::format("repair would move the surface by up to {} ({}), more than the "

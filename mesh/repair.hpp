@@ -2,6 +2,7 @@
 // Mesh checks and repair (CGAL Polygon Mesh Processing). A die or grain mesh must become a
 // closed, outward-oriented, non-self-intersecting solid before a signed distance means anything.
 // Repair never moves geometry by more than the user's tolerance without an error saying so.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,8 @@ struct RepairResult {
   std::vector<std::string> actions;  // each step that changed something, human readable
   bool repaired = false;             // anything changed at all
   bool wrapped = false;              // alpha wrapping was used
+  // Set when the winding-number solid was used: how far its re-meshing moved the surface [m].
+  std::optional<double> winding_moved_m;
   std::size_t holes_filled = 0;
   // Largest distance from the input surface to the result [m]: how far repair moved existing
   // geometry; checked against the tolerance.

@@ -15,29 +15,15 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "mesh/openvdb_adapter.hpp"
 #include "mesh/versions.hpp"
 
 namespace mesh {
 
 namespace {
 
-void initialise_openvdb() {
-  static std::once_flag once;
-  std::call_once(once, [] { openvdb::initialize(); });
-}
-
-// Points go to OpenVDB's index space in double precision, without a float copy.
-struct TriMeshAdapter {
-  const TriMesh& mesh;
-  double inverse_voxel;
-  std::size_t polygonCount() const { return mesh.triangles.size(); }
-  std::size_t pointCount() const { return mesh.vertices.size(); }
-  std::size_t vertexCount(std::size_t) const { return 3; }
-  void getIndexSpacePoint(std::size_t n, std::size_t v, openvdb::Vec3d& pos) const {
-    const Vec3& p = mesh.vertices[std::size_t(mesh.triangles[n][v])];
-    pos = openvdb::Vec3d(p.x(), p.y(), p.z()) * inverse_voxel;
-  }
-};
+using detail::initialise_openvdb;
+using detail::TriMeshAdapter;
 
 }  // namespace
 

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <vector>
 
 #include "mesh/cgal_ops.hpp"
@@ -63,38 +64,45 @@ TriMesh alpha_wrap(const TriMesh& soup, double alpha, double offset) {
   return out;
 }
 
-double max_distance(const TriMesh& from, const TriMesh& to, Samples samples) {
+double max_distance(const TriMesh& from, const TriMesh& to, const SampleFilter& counts) {
   const std::vector<Triangle3> target = triangles_of(to);
   if (target.empty() || from.triangles.empty()) return 0.0;
   Tree tree(target.begin(), target.end());
   tree.accelerate_distance_queries();
-  // Ray-crossing parity, the majority of three skew rays (one may graze an edge).
-  auto inside_target = [&](const Point& p) {
-    int votes = 0;
-    for (const K::Vector_3 direction : {K::Vector_3(0.5773, 0.5774, 0.5775), K::Vector_3(-0.6123, 0.3211, 0.7222),
-                                        K::Vector_3(0.2345, -0.8765, -0.4203)})
-      votes += tree.number_of_intersected_primitives(K::Ray_3(p, direction)) % 2;
-    return votes >= 2;
-  };
   double worst_squared = 0.0;
-  auto probe = [&](const Vec3& v) {
-    const Point p = to_point(v);
-    const double d2 = tree.squared_distance(p);
-    if (d2 > worst_squared && !(samples == Samples::outside_target && inside_target(p))) worst_squared = d2;
-  };
   // A barycentric grid on every triangle, about 16 points along its longest edge at most.
   const double diagonal = bounding_box(from).size().norm();
   for (const Triangle& t : from.triangles) {
     const Vec3& a = from.vertices[t[0]];
     const Vec3& b = from.vertices[t[1]];
     const Vec3& c = from.vertices[t[2]];
+    const Vec3 normal = (b - a).cross(c - a).normalized();
     const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
     const int k = std::clamp(int(std::ceil(longest / (diagonal * 1e-3))), 1, 16);
     for (int i = 0; i <= k; ++i)
-      for (int j = 0; i + j <= k; ++j)
-        probe(a + (b - a) * (double(i) / k) + (c - a) * (double(j) / k));
+      for (int j = 0; i + j <= k; ++j) {
+        const Vec3 v = a + (b - a) * (double(i) / k) + (c - a) * (double(j) / k);
+        const double d2 = tree.squared_distance(to_point(v));
+        if (d2 > worst_squared && (!counts || counts(v, normal))) worst_squared = d2;
+      }
   }
   return std::sqrt(worst_squared);
+}
+
+double max_distance(const TriMesh& from, const TriMesh& to, Samples samples) {
+  if (samples == Samples::all) return max_distance(from, to, SampleFilter{});
+  const std::vector<Triangle3> target = triangles_of(to);
+  if (target.empty()) return 0.0;
+  Tree tree(target.begin(), target.end());
+  // Ray-crossing parity, the majority of three skew rays (one may graze an edge).
+  auto outside_target = [&](const Vec3& v, const Vec3&) {
+    int votes = 0;
+    for (const K::Vector_3 direction : {K::Vector_3(0.5773, 0.5774, 0.5775), K::Vector_3(-0.6123, 0.3211, 0.7222),
+                                        K::Vector_3(0.2345, -0.8765, -0.4203)})
+      votes += tree.number_of_intersected_primitives(K::Ray_3(to_point(v), direction)) % 2;
+    return votes < 2;
+  };
+  return max_distance(from, to, outside_target);
 }
 
 }  // namespace mesh::detail

@@ -1,0 +1,169 @@
+// The winding-number solid (mesh/winding_solid.hpp): OpenVDB's unsigned distance of the soup,
+// signed by the generalized winding number, meshed at its zero surface.
+#include "mesh/winding_solid.hpp"
+
+#include <openvdb/tools/MeshToVolume.h>
+#include <openvdb/tools/SignedFloodFill.h>
+#include <openvdb/tools/VolumeToMesh.h>
+#include <openvdb/tree/LeafManager.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <unordered_map>
+
+#include "mesh/cgal_ops.hpp"
+#include "mesh/exact.hpp"
+#include "mesh/openvdb_adapter.hpp"
+#include "mesh/winding.hpp"
+
+namespace mesh::detail {
+
+namespace {
+
+// Cells of the distance band on each side of the surface. Where the region's surface crosses a
+// gap (a crack, a missing face) farther than the band from any triangle, no active voxel sees it
+// and OpenVDB leaves a hole in its mesh: the band is then doubled, up to the widest.
+constexpr float band_cells = 3.0f;
+constexpr float widest_band_cells = 24.0f;
+// Cells along the bounding box's longest side of the grid the ambiguous volume is measured on.
+constexpr int survey_cells = 96;
+
+bool ambiguous(double w) { return w > 0.25 && w < 0.75; }
+
+TriMesh to_trimesh(const std::vector<openvdb::Vec3s>& points, const std::vector<openvdb::Vec3I>& triangles,
+                   const std::vector<openvdb::Vec4I>& quads) {
+  TriMesh out;
+  out.vertices.reserve(points.size());
+  for (const openvdb::Vec3s& p : points) out.vertices.emplace_back(p.x(), p.y(), p.z());
+  for (const openvdb::Vec3I& t : triangles) out.triangles.push_back({int(t[0]), int(t[1]), int(t[2])});
+  for (const openvdb::Vec4I& q : quads) {
+    out.triangles.push_back({int(q[0]), int(q[1]), int(q[2])});
+    out.triangles.push_back({int(q[0]), int(q[2]), int(q[3])});
+  }
+  // OpenVDB winds its polygons for a level set negative inside; the mesh module's are
+  // counter-clockwise from outside.
+  if (signed_volume(out) < 0)
+    for (Triangle& t : out.triangles) std::swap(t[1], t[2]);
+  return out;
+}
+
+// The soup's unsigned distance within `band` cells, negated where the winding number is ≥ ½,
+// and its zero surface.
+TriMesh zero_surface(const TriMesh& soup, const WindingNumber& winding, double cell_m, float band) {
+  auto transform = openvdb::math::Transform::createLinearTransform(cell_m);
+  const TriMeshAdapter adapter{soup, 1.0 / cell_m};
+  openvdb::FloatGrid::Ptr grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
+      adapter, *transform, band, band, openvdb::tools::UNSIGNED_DISTANCE_FIELD);
+  openvdb::tree::LeafManager<openvdb::FloatTree> leaves(grid->tree());
+  leaves.foreach([&](openvdb::FloatTree::LeafNodeType& leaf, std::size_t) {
+    for (auto voxel = leaf.beginValueOn(); voxel; ++voxel) {
+      const openvdb::Vec3d p = transform->indexToWorld(voxel.getCoord());
+      if (winding(Vec3(p.x(), p.y(), p.z())) >= 0.5) voxel.setValue(-voxel.getValue());
+    }
+  });
+  // Beyond the band the sign follows the band's: inside stays inside.
+  openvdb::tools::signedFloodFill(grid->tree());
+  std::vector<openvdb::Vec3s> points;
+  std::vector<openvdb::Vec3I> triangles;
+  std::vector<openvdb::Vec4I> quads;
+  // No adaptivity: merged cells would cut curved faces by more than a cell, which moving the
+  // vertices onto the input (winding_solid) does not take back.
+  openvdb::tools::volumeToMesh(*grid, points, triangles, quads, 0.0, 0.0);
+  return to_trimesh(points, triangles, quads);
+}
+
+bool has_boundary(const TriMesh& mesh) {
+  std::unordered_map<std::uint64_t, int> uses;
+  uses.reserve(3 * mesh.triangles.size());
+  for (const Triangle& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint64_t a = std::uint32_t(t[k]), b = std::uint32_t(t[(k + 1) % 3]);
+      ++uses[a < b ? (a << 32) | b : (b << 32) | a];
+    }
+  return std::any_of(uses.begin(), uses.end(), [](const auto& use) { return use.second == 1; });
+}
+
+}  // namespace
+
+WindingSurvey survey_winding(const TriMesh& soup) {
+  const WindingNumber winding(soup);
+  const Box box = bounding_box(soup);
+  const double h = box.size().maxCoeff() / survey_cells;
+  const Eigen::Vector3i n = (box.size() / h).array().ceil().cast<int>().max(1);
+  struct Tally {
+    long solid = 0, unclear = 0;
+    Box box;
+  };
+  const Tally total = tbb::parallel_reduce(
+      tbb::blocked_range<int>(0, n.z()), Tally{},
+      [&](const tbb::blocked_range<int>& layers, Tally tally) {
+        for (int k = layers.begin(); k < layers.end(); ++k)
+          for (int j = 0; j < n.y(); ++j)
+            for (int i = 0; i < n.x(); ++i) {
+              const Vec3 p = box.lo + h * Vec3(i + 0.5, j + 0.5, k + 0.5);
+              const double w = winding(p);
+              if (w >= 0.5) ++tally.solid;
+              if (ambiguous(w)) {
+                ++tally.unclear;
+                tally.box.extend(p - Vec3::Constant(0.5 * h));
+                tally.box.extend(p + Vec3::Constant(0.5 * h));
+              }
+            }
+        return tally;
+      },
+      [](Tally a, const Tally& b) {
+        a.solid += b.solid;
+        a.unclear += b.unclear;
+        if (!b.box.empty()) {
+          a.box.extend(b.box.lo);
+          a.box.extend(b.box.hi);
+        }
+        return a;
+      });
+  WindingSurvey out;
+  const double cell_volume = h * h * h;
+  out.solid_volume_m3 = double(total.solid) * cell_volume;
+  out.ambiguous_volume_m3 = double(total.unclear) * cell_volume;
+  out.ambiguous_box = total.box;
+  return out;
+}
+
+double winding_solid_cells(double surface_area_m2, double cell_m) {
+  return 2.0 * double(band_cells) * surface_area_m2 / (cell_m * cell_m);
+}
+
+WindingSolid winding_solid(const TriMesh& soup, double cell_m) {
+  initialise_openvdb();
+  WindingSolid out;
+  const WindingNumber winding(soup);
+
+  for (float band = band_cells; out.mesh.triangles.empty() || has_boundary(out.mesh); band *= 2) {
+    if (band > widest_band_cells) {
+      out.mesh = {};
+      return out;
+    }
+    out.mesh = zero_surface(soup, winding, cell_m, band);
+  }
+  // The zero surface cuts corners by up to a cell; its vertices moved onto the closest input
+  // point lie on the surface the file means, sharp edges and flat faces included (a flat top
+  // face stays exactly flat, which the die's opening needs).
+  const ExactSurface surface(soup);
+  tbb::parallel_for(std::size_t(0), out.mesh.vertices.size(), [&](std::size_t v) {
+    const Vec3 closest = surface.closest_point(out.mesh.vertices[v]);
+    if ((closest - out.mesh.vertices[v]).norm() <= cell_m) out.mesh.vertices[v] = closest;
+  });
+
+  // What bounds the region in the input: sample points whose two sides fall on either side
+  // of ½ (a quarter cell off the face); faces buried inside or left in the open do not.
+  const double offset = 0.25 * cell_m;
+  out.moved_m = max_distance(soup, out.mesh, [&](const Vec3& p, const Vec3& normal) {
+    return (winding(p + offset * normal) >= 0.5) != (winding(p - offset * normal) >= 0.5);
+  });
+  return out;
+}
+
+}  // namespace mesh::detail

@@ -1,0 +1,35 @@
+#pragma once
+// Internal to the mesh module: the solid a messy surface means, as the region where its
+// generalized winding number (mesh/winding.hpp) is at least ½, re-meshed as a closed surface.
+// Repair's route for open, non-manifold and self-intersecting files (docs/INTERFACE.md, "Mesh
+// repair"): the existing surface is kept where it bounds that region, within the cell size.
+#include "mesh/trimesh.hpp"
+
+namespace mesh::detail {
+
+// Volumes of a soup's winding number, sampled at the centres of cells (96 along the bounding
+// box's longest side).
+struct WindingSurvey {
+  // Volume where the winding number lies between ¼ and ¾ [m³]: neither clearly inside nor
+  // clearly outside (around a hole or an open face), and the box that holds it.
+  double ambiguous_volume_m3 = 0.0;
+  Box ambiguous_box;
+  double solid_volume_m3 = 0.0;  // volume where the winding number is ≥ ½
+};
+WindingSurvey survey_winding(const TriMesh& soup);
+
+struct WindingSolid {
+  TriMesh mesh;  // closed, outward; empty when the region is empty or could not be closed
+  // Largest distance from the input's bounding surface (points whose two sides the winding
+  // number puts on different sides of ½) to the result [m]: how far the re-meshing moved it.
+  double moved_m = 0.0;
+};
+
+// The region of `soup` with winding number ≥ ½, meshed on cells of `cell_m` (OpenVDB: the
+// soup's unsigned distance signed by the winding number, then its zero surface).
+WindingSolid winding_solid(const TriMesh& soup, double cell_m);
+
+// Cells `winding_solid` would mesh, about: for refusing a re-mesh too fine to afford.
+double winding_solid_cells(double surface_area_m2, double cell_m);
+
+}  // namespace mesh::detail

@@ -1,0 +1,110 @@
+// mesh/winding and the repair route it opens: analytic winding numbers, the fast evaluation
+// against the exact sum, and a cracked solid re-meshed without moving its surface.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/error.hpp"
+#include "mesh/repair.hpp"
+#include "mesh/shapes.hpp"
+#include "mesh/winding.hpp"
+#include "meshes.hpp"
+
+using mesh::Vec3;
+
+namespace {
+
+Vec3 mm(double x, double y, double z) { return 1e-3 * Vec3(x, y, z); }
+
+mesh::TriMesh without_top(mesh::TriMesh box) {
+  std::erase_if(box.triangles, [&](const mesh::Triangle& t) {
+    return box.vertices[t[0]].z() > 9e-3 && box.vertices[t[1]].z() > 9e-3 && box.vertices[t[2]].z() > 9e-3;
+  });
+  return box;
+}
+
+}  // namespace
+
+TEST(WindingNumber, CountsAClosedSolidOnceInsideAndNeverOutside) {
+  const mesh::TriMesh box = test::box_mm(0, 10);
+  for (const Vec3& p : {mm(5, 5, 5), mm(0.01, 9.99, 0.01), mm(1, 2, 3)})
+    EXPECT_NEAR(mesh::exact_winding_number(box, p), 1.0, 1e-12);
+  for (const Vec3& p : {mm(-0.01, 5, 5), mm(20, 20, 20), mm(5, 5, 10.01)})
+    EXPECT_NEAR(mesh::exact_winding_number(box, p), 0.0, 1e-12);
+  // Two overlapping solids count twice where they overlap.
+  EXPECT_NEAR(mesh::exact_winding_number(test::joined(box, test::box_mm(5, 15)), mm(7, 7, 7)), 2.0, 1e-12);
+}
+
+TEST(WindingNumber, MeasuresTheSolidAngleOfAnOpenSurface) {
+  // A box without its top: from the centre each of the five faces subtends a sixth of the
+  // sphere; a point in the missing face's plane sees the open boundary as a half space inside
+  // the loop and edge-on outside it.
+  const mesh::TriMesh open = without_top(test::box_mm(0, 10));
+  ASSERT_EQ(open.triangles.size(), 10u);
+  EXPECT_NEAR(mesh::exact_winding_number(open, mm(5, 5, 5)), 5.0 / 6.0, 1e-12);
+  EXPECT_NEAR(mesh::exact_winding_number(open, mm(5, 5, 10)), 0.5, 1e-12);
+  EXPECT_NEAR(mesh::exact_winding_number(open, mm(3, 7, 10)), 0.5, 1e-12);
+  EXPECT_NEAR(mesh::exact_winding_number(open, mm(15, 5, 10)), 0.0, 1e-12);
+}
+
+TEST(WindingNumber, FastEvaluationClassifiesAsTheExactSum) {
+  // A ring cavity of a few thousand triangles: the tree's far clusters are dipoles. Points a
+  // hundredth of the ring's size or more from its surface are never classified differently.
+  const mesh::TriMesh ring = mesh::ring_cavity(30e-3, 12e-3, 10e-3, 2e-6);
+  ASSERT_GT(ring.triangles.size(), 1000u);
+  const mesh::WindingNumber fast(ring);
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> across(-20e-3, 20e-3), down(-15e-3, 5e-3);
+  int compared = 0;
+  while (compared < 2000) {
+    const Vec3 p(across(random), across(random), down(random));
+    const double radius = std::hypot(p.x(), p.y());
+    const double clearance = std::min({std::abs(radius - 15e-3), std::abs(radius - 6e-3), std::abs(p.z()),
+                                       std::abs(p.z() + 10e-3)});
+    if (clearance < 0.3e-3) continue;
+    const double exact = mesh::exact_winding_number(ring, p);
+    const bool inside = radius > 6e-3 && radius < 15e-3 && p.z() < 0 && p.z() > -10e-3;
+    ASSERT_NEAR(exact, inside ? 1.0 : 0.0, 1e-9) << p.transpose();
+    ASSERT_EQ(fast(p) >= 0.5, inside) << p.transpose() << " exact " << exact << " fast " << fast(p);
+    ++compared;
+  }
+}
+
+TEST(Repair, ClosesACrackByTheWindingNumberWithinTheTolerance) {
+  // The top face lifted 0.05 mm off the walls, unwelded: a crack all round, its loops 10 mm
+  // across (too wide to fill as holes), enclosing an evident 10 x 10 x 10.05 mm solid.
+  const mesh::TriMesh box = test::box_mm(0, 10);
+  mesh::TriMesh top;
+  top.vertices = {mm(0, 0, 10.05), mm(10, 0, 10.05), mm(10, 10, 10.05), mm(0, 10, 10.05)};
+  top.triangles = {{0, 1, 2}, {0, 2, 3}};
+  mesh::RepairOptions options;
+  options.tolerance_m = 0.2e-3;
+  options.max_hole_m = 2e-3;
+  const mesh::RepairResult r = mesh::repair(test::joined(without_top(box), top), options, "cracked.stl");
+  EXPECT_TRUE(r.after.closed);
+  EXPECT_EQ(r.after.self_intersections, 0u);
+  EXPECT_FALSE(r.wrapped);
+  ASSERT_TRUE(r.winding_moved_m.has_value());
+  EXPECT_LE(r.hausdorff_m, options.tolerance_m);
+  // Re-meshing on cells of the tolerance h, with every vertex moved onto the input, can cut
+  // each edge of the box by at most a right triangle of legs h: 120 mm of edges x h²/2.
+  const double h = options.tolerance_m;
+  EXPECT_NEAR(r.after.volume_m3, 10e-3 * 10e-3 * 10.05e-3, 120e-3 * h * h / 2);
+  // The top face stays flat at its height: the die's opening is found on it.
+  EXPECT_NEAR(r.after.bbox.hi.z(), 10.05e-3, 1e-9);
+}
+
+TEST(Repair, NamesTheRegionWhereTheEnclosedVolumeIsUndefined) {
+  try {
+    mesh::RepairOptions options;
+    options.tolerance_m = 0.1e-3;
+    mesh::repair(without_top(test::box_mm(0, 10)), options, "open.stl");
+    FAIL() << "an open box has no enclosed volume";
+  } catch (const diefill::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(e.field(), "boundary edges");
+    EXPECT_NE(what.find("undefined"), std::string::npos) << what;
+    // Around the missing top: the region reaches its plane, z = 10 mm.
+    EXPECT_NE(what.find("10] mm"), std::string::npos) << what;
+  }
+}
