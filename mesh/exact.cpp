@@ -76,7 +76,10 @@ ExactSurface::ExactSurface(const TriMesh& mesh) : impl_(std::make_unique<Impl>()
   s.inside_out = signed_volume(mesh) < 0;
   const Box box = bounding_box(mesh);
   s.centre = box.empty() ? Vec3::Zero() : Vec3((box.lo + box.hi) / 2);
-  s.device = rtcNewDevice("threads=1");
+  // No thread count: Embree with TBB holds a static tbb::global_control at the count it is given
+  // (RenderKit/embree issue 507), and "threads=1" left every later TBB loop of the process (the
+  // winding-number band, OpenVDB's SDF build) on one core.
+  s.device = rtcNewDevice(nullptr);
   s.scene = rtcNewScene(s.device);
   rtcSetSceneBuildQuality(s.scene, RTC_BUILD_QUALITY_HIGH);
   RTCGeometry geometry = rtcNewGeometry(s.device, RTC_GEOMETRY_TYPE_TRIANGLE);

@@ -178,10 +178,18 @@ TriMesh outward_pieces(SurfaceMesh sm) {
 
 // The winding-number route is refused beyond this much ambiguous volume, as a share of the
 // solid: a crack or a small hole leaves a sliver of it, a missing face a region as large as the
-// part (docs/INTERFACE.md, "Mesh repair"). The project's choice, not a published bound.
+// part (README, "Mesh repair"). The project's choice, not a published bound.
 constexpr double max_ambiguous_share = 0.01;
+// Survey cells the solid must fill for its ambiguous share to mean anything: a corrupt vertex
+// hundreds of metres away stretches the survey's box until the part sits in a cell or two
+// (the mutated dies of test_mesh_fuzz). A ring 100 mm across with walls of 1 mm fills about 2900.
+constexpr long min_survey_cells = 1000;
 // Distance-band cells beyond which the winding-number re-mesh takes minutes on two cores.
 constexpr double max_winding_cells = 1.5e8;
+// Winding-number terms (solid angles and dipoles) beyond which signing the distance band takes
+// over about half a minute on two cores (1.35·10⁹ terms took 20 s, the open gear of the shared
+// dies at cells of 0.0625 mm): counted, not timed, so that the choice is the same on every machine.
+constexpr double max_winding_terms = 2e9;
 
 // Alpha wraps beyond this size take minutes on two cores (1.4 million triangles: 250 s); the user is asked to repair
 // the mesh or accept a coarser tolerance instead.
@@ -193,12 +201,16 @@ constexpr double max_wrap_triangles = 3e5;
 // so that the alpha wrap is tried instead.
 std::optional<TriMesh> winding_number_solid(const SurfaceMesh& sm, const MeshReport& before,
                                             const RepairOptions& options, const std::string& source,
-                                            const std::string& defect, RepairResult& result) {
+                                            std::string& defect, RepairResult& result) {
   const double cell = options.tolerance_m;
   if (detail::winding_solid_cells(before.area_m2, cell) > max_winding_cells) return std::nullopt;
   diefill::Stopwatch clock;
   const TriMesh soup = outward_pieces(sm);
   const detail::WindingSurvey survey = detail::survey_winding(soup);
+  if (survey.solid_cells < min_survey_cells) {
+    diefill::log::debug("repair: the winding-number survey resolves the solid in {} cells only", survey.solid_cells);
+    return std::nullopt;
+  }
   if (survey.ambiguous_volume_m3 > max_ambiguous_share * survey.solid_volume_m3) {
     const Box& b = survey.ambiguous_box;
     throw InputError(source, "boundary edges",
@@ -212,9 +224,17 @@ std::optional<TriMesh> winding_number_solid(const SurfaceMesh& sm, const MeshRep
                                  b.lo.z() * 1e3, b.hi.x() * 1e3, b.hi.y() * 1e3, b.hi.z() * 1e3),
                      "Close the mesh in CAD there");
   }
-  detail::WindingSolid solid = detail::winding_solid(soup, cell);
+  detail::WindingSolid solid = detail::winding_solid(soup, cell, max_winding_terms);
   diefill::log::debug("repair: winding-number solid ({} triangles, moved {}) in {:.2f} s",
                       solid.mesh.triangles.size(), mm(solid.moved_m), clock.seconds());
+  if (solid.refused_terms > 0) {
+    // The band's voxels, and so the terms, grow as the inverse square of the cell.
+    defect += fmt::format("; re-meshing the solid its winding number encloses on cells of {} would sum "
+                          "about {:.2g}·10⁹ terms, more than the {:.2g}·10⁹ affordable (a tolerance of about {} would be)",
+                          mm(cell), solid.refused_terms / 1e9, max_winding_terms / 1e9,
+                          mm(cell * std::sqrt(solid.refused_terms / max_winding_terms)));
+    return std::nullopt;
+  }
   if (solid.mesh.triangles.empty() || solid.moved_m > options.tolerance_m) return std::nullopt;
   result.actions.push_back(fmt::format(
       "{}: re-meshed as the solid its winding number encloses (cells of {}; ambiguous volume {:.4g} mm³, "
@@ -237,7 +257,7 @@ TriMesh alpha_wrapped(const TriMesh& input, const MeshReport& before, const Repa
     throw InputError(source, "boundary edges",
                      defect + fmt::format("; holes larger than {} are not filled",
                                           mm(options.max_hole_m)),
-                     "Close the mesh in CAD, or raise the largest hole to fill (--max-hole)");
+                     "Close the mesh in CAD, or raise the tolerance (--tolerance) or the largest hole to fill (--max-hole)");
   if (!options.allow_wrap)
     throw InputError(source, "surface", defect,
                      "Repair the mesh in CAD, or allow the alpha-wrap fallback");

@@ -74,9 +74,10 @@ int WindingNumber::build(int first, int count) {
   return index;
 }
 
-double WindingNumber::operator()(const Vec3& p) const {
+template <bool counting>
+double WindingNumber::sum(const Vec3& p, std::size_t& terms) const {
   if (nodes_.empty()) return 0.0;
-  double sum = 0.0;
+  double total = 0.0;
   int stack[128];
   int top = 0;
   stack[top++] = 0;
@@ -85,18 +86,31 @@ double WindingNumber::operator()(const Vec3& p) const {
     const Vec3 r = node.centre - p;
     const double distance = r.norm();
     if (distance > accuracy_ * node.radius) {
-      sum += node.area_vector.dot(r) / (distance * distance * distance);
+      if constexpr (counting) ++terms;
+      total += node.area_vector.dot(r) / (distance * distance * distance);
     } else if (node.left < 0) {
+      if constexpr (counting) terms += std::size_t(node.count);
       for (int i = node.first; i < node.first + node.count; ++i) {
         const Triangle& t = soup_.triangles[std::size_t(order_[std::size_t(i)])];
-        sum += solid_angle(p, soup_.vertices[t[0]], soup_.vertices[t[1]], soup_.vertices[t[2]]);
+        total += solid_angle(p, soup_.vertices[t[0]], soup_.vertices[t[1]], soup_.vertices[t[2]]);
       }
     } else {
       stack[top++] = node.left;
       stack[top++] = node.right;
     }
   }
-  return sum / four_pi;
+  return total;
+}
+
+double WindingNumber::operator()(const Vec3& p) const {
+  std::size_t unused = 0;
+  return sum<false>(p, unused) / four_pi;
+}
+
+std::size_t WindingNumber::terms(const Vec3& p) const {
+  std::size_t terms = 0;
+  sum<true>(p, terms);
+  return terms;
 }
 
 }  // namespace mesh

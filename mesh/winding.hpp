@@ -26,6 +26,9 @@ class WindingNumber {
   // times its radius from its centre; the truncation error then falls as β⁻².
   explicit WindingNumber(const TriMesh& soup, double accuracy = 2.0);
   double operator()(const Vec3& p) const;
+  // Terms (exact solid angles and far-field dipoles) summed for p: the cost of operator()(p),
+  // counted instead of timed so that what it decides is the same on every machine.
+  std::size_t terms(const Vec3& p) const;
 
  private:
   struct Node {
@@ -36,6 +39,8 @@ class WindingNumber {
     int left, right;   // children, -1 for a leaf
   };
   int build(int first, int count);
+  template <bool counting>
+  double sum(const Vec3& p, std::size_t& terms) const;
   const TriMesh& soup_;
   std::vector<int> order_;
   std::vector<Vec3> centroids_, area_vectors_;

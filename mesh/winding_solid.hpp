@@ -1,7 +1,7 @@
 #pragma once
 // Internal to the mesh module: the solid a messy surface means, as the region where its
 // generalized winding number (mesh/winding.hpp) is at least ½, re-meshed as a closed surface.
-// Repair's route for open, non-manifold and self-intersecting files (docs/INTERFACE.md, "Mesh
+// Repair's route for open, non-manifold and self-intersecting files (README, "Mesh
 // repair"): the existing surface is kept where it bounds that region, within the cell size.
 #include "mesh/trimesh.hpp"
 
@@ -15,6 +15,7 @@ struct WindingSurvey {
   double ambiguous_volume_m3 = 0.0;
   Box ambiguous_box;
   double solid_volume_m3 = 0.0;  // volume where the winding number is ≥ ½
+  long solid_cells = 0;          // cells it was measured on
 };
 WindingSurvey survey_winding(const TriMesh& soup);
 
@@ -23,11 +24,15 @@ struct WindingSolid {
   // Largest distance from the input's bounding surface (points whose two sides the winding
   // number puts on different sides of ½) to the result [m]: how far the re-meshing moved it.
   double moved_m = 0.0;
+  // Terms (WindingNumber::terms) signing the distance band would have summed, where that was
+  // more than allowed: the mesh is empty then.
+  double refused_terms = 0.0;
 };
 
 // The region of `soup` with winding number ≥ ½, meshed on cells of `cell_m` (OpenVDB: the
-// soup's unsigned distance signed by the winding number, then its zero surface).
-WindingSolid winding_solid(const TriMesh& soup, double cell_m);
+// soup's unsigned distance signed by the winding number, then its zero surface), unless
+// signing it would sum more than `max_terms` winding-number terms.
+WindingSolid winding_solid(const TriMesh& soup, double cell_m, double max_terms);
 
 // Cells `winding_solid` would mesh, about: for refusing a re-mesh too fine to afford.
 double winding_solid_cells(double surface_area_m2, double cell_m);

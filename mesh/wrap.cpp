@@ -34,6 +34,28 @@ std::vector<Triangle3> triangles_of(const TriMesh& mesh) {
                      to_point(mesh.vertices[t[2]]));
   return out;
 }
+
+// Largest distance from a barycentric grid of sample points on `from` (about 16 along a
+// triangle's longest edge at most) to `tree`, over the points `counts` accepts.
+double max_distance_to(const TriMesh& from, const Tree& tree, const SampleFilter& counts) {
+  double worst_squared = 0.0;
+  const double diagonal = bounding_box(from).size().norm();
+  for (const Triangle& t : from.triangles) {
+    const Vec3& a = from.vertices[t[0]];
+    const Vec3& b = from.vertices[t[1]];
+    const Vec3& c = from.vertices[t[2]];
+    const Vec3 normal = (b - a).cross(c - a).normalized();
+    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    const int k = std::clamp(int(std::ceil(longest / (diagonal * 1e-3))), 1, 16);
+    for (int i = 0; i <= k; ++i)
+      for (int j = 0; i + j <= k; ++j) {
+        const Vec3 v = a + (b - a) * (double(i) / k) + (c - a) * (double(j) / k);
+        const double d2 = tree.squared_distance(to_point(v));
+        if (d2 > worst_squared && (!counts || counts(v, normal))) worst_squared = d2;
+      }
+  }
+  return std::sqrt(worst_squared);
+}
 }  // namespace
 
 TriMesh alpha_wrap(const TriMesh& soup, double alpha, double offset) {
@@ -69,31 +91,15 @@ double max_distance(const TriMesh& from, const TriMesh& to, const SampleFilter& 
   if (target.empty() || from.triangles.empty()) return 0.0;
   Tree tree(target.begin(), target.end());
   tree.accelerate_distance_queries();
-  double worst_squared = 0.0;
-  // A barycentric grid on every triangle, about 16 points along its longest edge at most.
-  const double diagonal = bounding_box(from).size().norm();
-  for (const Triangle& t : from.triangles) {
-    const Vec3& a = from.vertices[t[0]];
-    const Vec3& b = from.vertices[t[1]];
-    const Vec3& c = from.vertices[t[2]];
-    const Vec3 normal = (b - a).cross(c - a).normalized();
-    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
-    const int k = std::clamp(int(std::ceil(longest / (diagonal * 1e-3))), 1, 16);
-    for (int i = 0; i <= k; ++i)
-      for (int j = 0; i + j <= k; ++j) {
-        const Vec3 v = a + (b - a) * (double(i) / k) + (c - a) * (double(j) / k);
-        const double d2 = tree.squared_distance(to_point(v));
-        if (d2 > worst_squared && (!counts || counts(v, normal))) worst_squared = d2;
-      }
-  }
-  return std::sqrt(worst_squared);
+  return max_distance_to(from, tree, counts);
 }
 
 double max_distance(const TriMesh& from, const TriMesh& to, Samples samples) {
-  if (samples == Samples::all) return max_distance(from, to, SampleFilter{});
   const std::vector<Triangle3> target = triangles_of(to);
-  if (target.empty()) return 0.0;
+  if (target.empty() || from.triangles.empty()) return 0.0;
   Tree tree(target.begin(), target.end());
+  tree.accelerate_distance_queries();
+  if (samples == Samples::all) return max_distance_to(from, tree, SampleFilter{});
   // Ray-crossing parity, the majority of three skew rays (one may graze an edge).
   auto outside_target = [&](const Vec3& v, const Vec3&) {
     int votes = 0;
@@ -102,7 +108,7 @@ double max_distance(const TriMesh& from, const TriMesh& to, Samples samples) {
       votes += tree.number_of_intersected_primitives(K::Ray_3(to_point(v), direction)) % 2;
     return votes < 2;
   };
-  return max_distance(from, to, outside_target);
+  return max_distance_to(from, tree, outside_target);
 }
 
 }  // namespace mesh::detail
