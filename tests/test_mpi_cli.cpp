@@ -99,16 +99,19 @@ TEST(MpiRun, ACheckpointOfTwoRanksResumesOnThree) {
   const nlohmann::json report = nlohmann::json::parse(test::read_text(dir / "ring" / "report.json"));
   EXPECT_EQ(report["timing"]["ranks"], 3);
   // The resumed trajectory depends on when the interrupt landed, so it is one more draw of the
-  // fill, not the uninterrupted run's: every grain counted, and the fill within the seeds'
-  // spread. A grain or two may spill over the table's edge beside the shoe in such a draw
-  // (measured this session: 1 and 2 of 2005 in two of three draws; the default ring spills one
-  // of 16 042 single-process): counted as particles.lost, harmless to the fill, issue 19's
-  // "lost 0" point. A grain through the die would have stopped the run (check_losses).
+  // fill from the uninterrupted run's settled shoe: every grain counted, and the fill within four
+  // seed deviations of that run's. Not of the seeds' mean: a settled shoe shifts the fill its
+  // draws scatter about (this shoe on 2 ranks fills 0.5138; four resumed draws, 2026-12-03:
+  // 0.5131, 0.5166, 0.5131 and, in CI, 0.5102, mean 0.5133; the last lies 4.3 seed deviations
+  // from the seeds' mean, 1.6 from its shoe's run). A grain or two may spill over the table's
+  // edge beside the shoe in such a draw (measured: 1 and 2 of 2005 in two of three draws; the
+  // default ring spills one of 16 042 single-process): counted as particles.lost, harmless to the
+  // fill, issue 19's "lost 0" point. A grain through the die would have stopped the run
+  // (check_losses).
   const nlohmann::json& p = report["particles"];
   EXPECT_EQ(p["inserted"], grains_inserted_on_seed_1);
   EXPECT_EQ(p["inserted"].get<std::int64_t>(), p["in_cavity"].get<std::int64_t>() + p["in_shoe"].get<std::int64_t>() +
                                                    p["elsewhere"].get<std::int64_t>() + p["lost"].get<std::int64_t>());
-  EXPECT_NEAR(report["fill"]["fill_ratio"].get<double>(), single_process_fill_mean, 4 * single_process_fill_sd);
   EXPECT_NEAR(report["fill"]["fill_ratio"].get<double>(), uninterrupted["fill"]["fill_ratio"].get<double>(),
               4 * single_process_fill_sd);
   EXPECT_FALSE(fs::exists(dir / "ring" / "checkpoint.bin")) << "a finished run removes its checkpoint";
