@@ -14,7 +14,7 @@ namespace dem {
 
 namespace {
 
-constexpr char magic[8] = {'D', 'F', 'C', 'K', 'P', 'T', '0', '4'};
+constexpr char magic[8] = {'D', 'F', 'C', 'K', 'P', 'T', '0', '5'};
 constexpr char split_magic[8] = {'D', 'F', 'C', 'K', 'S', 'P', '0', '2'};
 
 struct Writer {
@@ -61,6 +61,7 @@ void fields(IO& io, S& s) {
   io.array(s.active);
   io.array(s.body);
   io.array(s.wall_slots);
+  io.array(s.wall_candidates);  // where the wall queries start: a resumed run tracks on alike
   auto& b = s.bodies;
   io.array(b.x);
   io.array(b.v);

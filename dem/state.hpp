@@ -23,13 +23,19 @@ struct WallSlot {
   ContactHistory history;
 };
 
-// The closest triangles of the voxel cell a grain was last in, per mesh wall: a grain crosses
-// a cell every thousand steps or so, and re-reading the voxels every step cost a fifth of the
-// run time in cache misses. Derived data: it never changes a result.
+// Where a grain's wall queries start, per mesh wall: the closest triangles of the voxel cell it
+// was in, each moved on to where its walk to a local minimum ended, with watches where a walk
+// left a surface over a sharp edge (mesh::WallField::local_minima_tracked), so that a query walks
+// over a triangle or none instead of a voxel's worth of them: the wall cost does not grow with
+// the tessellation. Read afresh from the voxels when the grain is a quarter voxel beyond the cell
+// (dem/walls.cpp) and at every neighbour build, when grains migrate between ranks. Part of the
+// state, and of the checkpoint: where a concave tessellated wall holds minima on neighbouring
+// facets a tracked query may keep another than a fresh one would (docs/ARCHITECTURE.md, "Walls as
+// signed-distance fields").
 struct WallCandidates {
   std::array<int, 3> cell{};
   std::int32_t count = -1;  // -1: not filled yet
-  std::int32_t triangles[8];
+  std::int32_t triangles[8];  // a triangle to walk from, or ~t: a watch on triangle t
 };
 
 // The half neighbour list (j > i) in compressed rows, with each pair's contact history beside

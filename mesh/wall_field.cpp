@@ -120,7 +120,12 @@ double WallField::trilinear(const Vec3& p) const {
   return value;
 }
 
-SurfacePoint WallField::descend(const Vec3& p, int start) const {
+namespace {
+// Normals closer than smooth_angle_deg lie on one smooth surface.
+const double same_surface = std::cos(smooth_angle_deg * 3.14159265358979323846 / 180.0);
+}  // namespace
+
+SurfacePoint WallField::descend(const Vec3& p, int start, int* anchor, bool stop_at_sharp_edge) const {
   auto closest_on = [&](int t) {
     const Triangle& tri = triangles[std::size_t(t)];
     return closest_feature(p, vertices[tri[0]], vertices[tri[1]], vertices[tri[2]]);
@@ -128,8 +133,9 @@ SurfacePoint WallField::descend(const Vec3& p, int start) const {
   int current = start;
   ClosestPoint cp = closest_on(current);
   double d2 = (p - cp.point).squaredNorm();
-  // Walk to a neighbouring triangle while it is strictly closer: a few steps at most, since the
-  // start is the closest triangle of a voxel corner within a voxel of p.
+  if (anchor) *anchor = -1;
+  // Walk to a neighbouring triangle while it is strictly closer: a few steps from a voxel
+  // corner's closest triangle on a coarse surface, one or none from a tracked seed.
   for (int step = 0; step < 64 && cp.feature != Feature::face; ++step) {
     int best = -1;
     ClosestPoint best_cp = cp;
@@ -144,15 +150,34 @@ SurfacePoint WallField::descend(const Vec3& p, int start) const {
       consider(neighbours[std::size_t(current)][std::size_t(cp.index)]);
     } else {
       const int v = triangles[std::size_t(current)][std::size_t(cp.index)];
-      for (int n = vertex_face_offsets[std::size_t(v)]; n < vertex_face_offsets[std::size_t(v) + 1]; ++n)
-        consider(vertex_faces[std::size_t(n)]);
+      const int* fan = &vertex_faces[std::size_t(vertex_face_offsets[std::size_t(v)])];
+      const int* fan_end = &vertex_faces[0] + vertex_face_offsets[std::size_t(v) + 1];
+      if (stop_at_sharp_edge) {
+        // Watching a surface: a closer face of it moves the walk on; failing that, the first
+        // closer face across a sharp edge ends the walk. A vertex where a fine cap meets a wall
+        // may hold a hundred faces, and the watch is asked at every step.
+        const auto smooth = [&](int t) { return face_normals[std::size_t(current)].dot(face_normals[std::size_t(t)]) > same_surface; };
+        for (const int* f = fan; f < fan_end; ++f)
+          if (smooth(*f)) consider(*f);
+        for (const int* f = fan; f < fan_end && best < 0; ++f)
+          if (!smooth(*f)) consider(*f);
+      } else {
+        for (const int* f = fan; f < fan_end; ++f) consider(*f);
+      }
     }
     if (best < 0) break;
+    if (anchor && *anchor < 0 && face_normals[std::size_t(current)].dot(face_normals[std::size_t(best)]) <= same_surface) {
+      *anchor = current;
+      if (stop_at_sharp_edge) break;
+    }
     current = best;
     cp = best_cp;
     d2 = (p - cp.point).squaredNorm();
   }
 
+  // The result is computed from the feature alone, whichever triangle the walk reached it by, so
+  // that walks from different seeds give the same minimum bit for bit (and a tracked query the
+  // result of a fresh one).
   const Triangle& tri = triangles[std::size_t(current)];
   SurfacePoint out;
   out.point = cp.point;
@@ -163,20 +188,28 @@ SurfacePoint WallField::descend(const Vec3& p, int start) const {
       out.feature = std::uint64_t(current);
       break;
     case Feature::edge: {
-      const int a = tri[std::size_t(cp.index)], b = tri[std::size_t(cp.index + 1) % 3];
-      out.feature = (1ull << 62) | (std::uint64_t(std::min(a, b)) << 31) | std::uint64_t(std::max(a, b));
+      const int a = std::min(tri[std::size_t(cp.index)], tri[std::size_t(cp.index + 1) % 3]);
+      const int b = std::max(tri[std::size_t(cp.index)], tri[std::size_t(cp.index + 1) % 3]);
+      out.feature = (1ull << 62) | (std::uint64_t(a) << 31) | std::uint64_t(b);
+      const Vec3 ab = vertices[std::size_t(b)] - vertices[std::size_t(a)];
+      const double length2 = ab.squaredNorm();  // zero on an edge of coincident vertices
+      out.point = vertices[std::size_t(a)] + (length2 > 0 ? std::clamp((p - vertices[std::size_t(a)]).dot(ab) / length2, 0.0, 1.0) : 0.0) * ab;
       const int n = neighbours[std::size_t(current)][std::size_t(cp.index)];
-      if (n >= 0) pseudo_normal += face_normals[std::size_t(n)];
+      if (n >= 0) {
+        out.triangle = std::min(current, n);
+        pseudo_normal = face_normals[std::size_t(out.triangle)] + face_normals[std::size_t(std::max(current, n))];
+      }
       break;
     }
     case Feature::vertex: {
       const int v = tri[std::size_t(cp.index)];
       out.feature = (2ull << 62) | std::uint64_t(v);
+      out.triangle = vertex_faces[std::size_t(vertex_face_offsets[std::size_t(v)])];  // the lowest: faces are listed ascending
       pseudo_normal = vertex_normals[std::size_t(v)];
       break;
     }
   }
-  const Vec3 diff = p - cp.point;
+  const Vec3 diff = p - out.point;
   const double length = diff.norm();
   const double sign = diff.dot(pseudo_normal) >= 0 ? 1.0 : -1.0;
   out.distance = sign * length;
@@ -233,9 +266,9 @@ int WallField::candidates(const Vec3& p, int reach, std::int32_t* out, int capac
 }
 
 int WallField::local_minima(const Vec3& p, double range, SurfacePoint* out, int capacity) const {
-  std::int32_t triangles_near[8];
-  const int count = cell_candidates(cell_of(p), triangles_near);
-  return local_minima_from(p, range, triangles_near, count, out, capacity);
+  std::int32_t seeds[8];
+  std::int32_t count = cell_candidates(cell_of(p), seeds);
+  return local_minima_tracked(p, range, seeds, count, out, capacity);
 }
 
 int WallField::descend_all(const Vec3& p, const std::int32_t* triangles_near, int count, SurfacePoint* out) const {
@@ -259,8 +292,7 @@ int WallField::descend_all(const Vec3& p, const std::int32_t* triangles_near, in
 // (beyond the grid's error, under 0.42 voxel on the shared dies: `diefill sdf --verify`), the
 // grid's sign wins and the minima are turned round. Grains sit outside the walls, so this costs a
 // grid read only where a contact overlaps deeply.
-int WallField::consistent_minima(const Vec3& p, const std::int32_t* triangles_near, int count, SurfacePoint* found) const {
-  int n = descend_all(p, triangles_near, count, found);
+int WallField::consistent_minima(const Vec3& p, SurfacePoint* found, int n, bool* widened) const {
   const auto nearest = [&] {
     int best = 0;
     for (int c = 1; c < n; ++c)
@@ -274,7 +306,9 @@ int WallField::consistent_minima(const Vec3& p, const std::int32_t* triangles_ne
   };
   const bool looks_inside = n > 0 && found[nearest()].distance < 0;
   const double grid = looks_inside ? trilinear(p) : 0.0;
-  if (mixed() || grid > 0) {
+  const bool widen = mixed() || grid > 0;
+  if (widened) *widened = widen;
+  if (widen) {
     std::int32_t wider[27];
     n = descend_all(p, wider, candidates(p, 1, wider, 27), found);
   }
@@ -289,15 +323,13 @@ int WallField::consistent_minima(const Vec3& p, const std::int32_t* triangles_ne
   return kept;
 }
 
-int WallField::local_minima_from(const Vec3& p, double range, const std::int32_t* triangles_near, int count,
-                                 SurfacePoint* out, int capacity) const {
+int WallField::merged_minima(SurfacePoint* minima, int n, double range, SurfacePoint* out, int capacity) {
   // Minima with nearly parallel normals lie on one smooth surface: a tessellated curve seen
   // from its concave side has a minimum on each facet near a facet edge, and counting both
   // would double the force there. Only the deepest of them is a contact; minima whose normals
-  // differ by more than `smooth_angle` (a concave corner) are contacts each.
-  static const double same_surface = std::cos(smooth_angle_deg * 3.14159265358979323846 / 180.0);
-  SurfacePoint minima[27];
-  const int n = consistent_minima(p, triangles_near, count, minima);
+  // differ by more than `smooth_angle` (a concave corner) are contacts each. Taken in the order
+  // of their features, so that the same minima give the same contacts whichever walks found them.
+  std::sort(minima, minima + n, [](const SurfacePoint& a, const SurfacePoint& b) { return a.feature < b.feature; });
   int found = 0;
   for (int c = 0; c < n; ++c) {
     const SurfacePoint& s = minima[c];
@@ -314,11 +346,43 @@ int WallField::local_minima_from(const Vec3& p, double range, const std::int32_t
   return found;
 }
 
+int WallField::local_minima_tracked(const Vec3& p, double range, std::int32_t* seeds, std::int32_t& count,
+                                    SurfacePoint* out, int capacity) const {
+  // A seed is a triangle to walk from, or (stored as ~t) an anchor: the last triangle of a smooth
+  // surface that an earlier walk left over a sharp edge. A walk from an anchor that would cross
+  // that edge again stops there and finds nothing (its minimum beyond is a seed of its own); one
+  // that stays on the surface has found a minimum that appeared there as the point moved.
+  SurfacePoint minima[27];
+  std::int32_t next[16];
+  int n = 0, next_count = 0;
+  const auto track = [&](std::int32_t seed) {
+    if (std::find(next, next + next_count, seed) == next + next_count) next[next_count++] = seed;
+  };
+  for (int c = 0; c < count; ++c) {
+    const bool watching = seeds[c] < 0;
+    int anchor = -1;
+    const SurfacePoint minimum = descend(p, watching ? ~seeds[c] : seeds[c], &anchor, watching);
+    if (anchor >= 0) track(~anchor);
+    if (anchor >= 0 && watching) continue;
+    minima[n++] = minimum;
+    track(minimum.triangle);
+  }
+  bool widened = false;
+  n = consistent_minima(p, minima, n, &widened);
+  // Seeds move on unless the walks disagreed in sign (the wider voxels decided then) or there are
+  // more than fit: the same seeds are walked again next time.
+  if (!widened && next_count <= 8) {
+    std::copy(next, next + next_count, seeds);
+    count = next_count;
+  }
+  return merged_minima(minima, n, range, out, capacity);
+}
+
 bool WallField::nearest(const Vec3& p, int reach, SurfacePoint& out) const {
   std::int32_t triangles_near[27];
   const int count = candidates(p, reach, triangles_near, 27);
   SurfacePoint minima[27];
-  const int n = consistent_minima(p, triangles_near, count, minima);
+  const int n = consistent_minima(p, minima, descend_all(p, triangles_near, count, minima), nullptr);
   for (int c = 0; c < n; ++c)
     if (c == 0 || std::abs(minima[c].distance) < std::abs(out.distance)) out = minima[c];
   return n > 0;

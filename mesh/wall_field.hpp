@@ -76,11 +76,17 @@ struct WallField {
   // to `out` (at most `capacity`); returns how many were found. Minima on one smooth surface
   // (normals within smooth_angle_deg) count once, at the deepest.
   int local_minima(const Vec3& p, double range, SurfacePoint* out, int capacity) const;
-  // The same, from a given candidate list (the closest triangles of p's cell, see cell_of and
-  // cell_candidates): callers that step a point slowly through the grid reuse the list while
-  // the point stays in its cell, and save the voxel reads.
-  int local_minima_from(const Vec3& p, double range, const std::int32_t* candidates, int count,
-                        SurfacePoint* out, int capacity) const;
+  // The same, tracked from a point's previous query: `seeds` (count of them, at most 8) start as
+  // the closest triangles of p's cell (cell_of, cell_candidates) and are replaced by where their
+  // walks to a local minimum ended, so that the next query of a point that moved a little walks
+  // over a triangle or none, however finely the surface is tessellated (a walk from a voxel
+  // corner crosses as many triangles as fit in a voxel: hundreds of slivers). A walk that
+  // crossed a sharp edge (normals more than smooth_angle_deg apart) also leaves a watch on the
+  // surface it left, where a minimum of its own may appear as the point moves on. Minima are
+  // the same whichever seeds lead to them (one feature, one result, bit for bit) and come in the
+  // order of their features.
+  int local_minima_tracked(const Vec3& p, double range, std::int32_t* seeds, std::int32_t& count,
+                           SurfacePoint* out, int capacity) const;
   // Integer coordinates of the voxel cell containing p, and the distinct closest triangles of
   // its eight corners (at most 8).
   std::array<int, 3> cell_of(const Vec3& p) const;
@@ -97,11 +103,17 @@ struct WallField {
   bool voxel_at(int i, int j, int k, float& value, std::int32_t& triangle) const;
   // Distinct closest triangles of the voxels around p (see nearest); returns their number.
   int candidates(const Vec3& p, int reach, std::int32_t* out, int capacity) const;
-  SurfacePoint descend(const Vec3& p, int triangle) const;
+  // The local minimum a walk from `triangle` ends at. `anchor` (if given) receives the last
+  // triangle before the walk first crossed a sharp edge (normals more than smooth_angle_deg
+  // apart), or -1; with `stop_at_sharp_edge` the walk ends there.
+  SurfacePoint descend(const Vec3& p, int triangle, int* anchor = nullptr, bool stop_at_sharp_edge = false) const;
   int descend_all(const Vec3& p, const std::int32_t* triangles_near, int count, SurfacePoint* out) const;
-  // The minima from these candidates, widened to the 3x3x3 voxels when they disagree in sign,
-  // with those of the nearest one's sign kept (at most 27).
-  int consistent_minima(const Vec3& p, const std::int32_t* triangles_near, int count, SurfacePoint* found) const;
+  // These minima (n of them, in `found`), replaced by those of the 3x3x3 voxels when they
+  // disagree in sign, with those of the nearest one's sign kept (at most 27); `widened` (if
+  // given) tells whether the wider voxels were asked.
+  int consistent_minima(const Vec3& p, SurfacePoint* found, int n, bool* widened) const;
+  // Distinct minima within `range`, one per smooth surface, in the order of their features.
+  static int merged_minima(SurfacePoint* minima, int n, double range, SurfacePoint* out, int capacity);
 };
 
 }  // namespace mesh

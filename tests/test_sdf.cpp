@@ -7,6 +7,7 @@
 #include "mesh/exact.hpp"
 #include "mesh/import.hpp"
 #include "mesh/shapes.hpp"
+#include "mesh/tool.hpp"
 #include "mesh/verify.hpp"
 #include "support.hpp"
 
@@ -181,3 +182,52 @@ TEST(Sdf, InteriorBandHoldsATrilinearSampleOneAndAHalfVoxelsDeep) {
   }
 }
 
+
+// A query tracked from the point's previous one (WallField::local_minima_tracked, as the wall
+// stage asks it) on a die of slivers: a Ø20 mm disc cavity with 15,708 full-height side quads
+// 4 µm wide and caps fanned from the axis, a point moving down a helix 0.2 mm inside the side
+// wall into the corner with the floor, a micron a step. At every step the deepest contact is the
+// exact distance (CGAL's closest point) within the facets' sagitta (the minima on neighbouring
+// facets of the concave side differ by less: which of them is kept may differ), a fresh query
+// from the cell's corners finds as many contacts, each within the sagitta, and near the floor
+// both faces of the corner are contacts.
+TEST(WallQuery, TrackedQueriesOnSliversFindTheExactClosestPointAsFreshOnesDo) {
+  const double radius = 10e-3, chord = 2e-10;
+  const mesh::TriMesh cavity = mesh::ring_cavity(2 * radius, 0.0, 10e-3, chord);
+  const mesh::TriMesh tool = mesh::tool_from_cavity(cavity, mesh::table_around(cavity, 3e-3), "slivers").mesh;
+  mesh::SdfOptions o;
+  o.voxel_m = 0.125e-3;
+  o.exterior_band_m = 8 * o.voxel_m;
+  o.interior_band_m = 2 * o.voxel_m;
+  const mesh::WallField field = mesh::build_sdf(tool, o).wall_field(tool);
+  const mesh::ExactSurface exact(tool);
+  const int segments = int(cavity.triangles.size()) / 4;  // two per side quad, one in each cap's fan
+  ASSERT_GT(segments, 15000);
+  const double sagitta = radius * (1 - std::cos(3.14159265358979 / segments));
+  const double range = 0.25e-3, inset = 0.2e-3;
+  std::array<int, 3> cell{};
+  std::int32_t seeds[8], count = -1;
+  int both_faces = 0;
+  for (int step = 0; step <= 9000; ++step) {
+    const double z = std::max(-2e-3 - 1e-6 * step, -10e-3 + 0.15e-3);
+    const double angle = 0.3 * step / 9000.0;
+    const Vec3 p((radius - inset) * std::cos(angle), (radius - inset) * std::sin(angle), z);
+    if (count < 0 || field.cell_of(p) != cell) {
+      cell = field.cell_of(p);
+      count = field.cell_candidates(cell, seeds);
+    }
+    mesh::SurfacePoint tracked[4], fresh[4];
+    const int n = field.local_minima_tracked(p, range, seeds, count, tracked, 4);
+    const int m = field.local_minima(p, range, fresh, 4);
+    ASSERT_GT(n, 0) << "step " << step;
+    ASSERT_EQ(n, m) << "step " << step;
+    double deepest = tracked[0].distance;
+    for (int k = 0; k < n; ++k) {
+      deepest = std::min(deepest, tracked[k].distance);
+      EXPECT_NEAR(tracked[k].distance, fresh[k].distance, sagitta) << "step " << step;
+    }
+    EXPECT_NEAR(deepest, exact.signed_distance(p), sagitta) << "step " << step;
+    both_faces += n == 2;
+  }
+  EXPECT_GT(both_faces, 100) << "the corner with the floor was reached";
+}
