@@ -12,18 +12,12 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 size="${1:-5k}"; repeats="${2:-5}"; steps="${3:-15000}"
 source "$root/bench/liggghts_pack.sh"
 mpi=(mpirun --allow-run-as-root --oversubscribe -np 2)
-liggghts_rate() {  # ranks...
-  local loop
-  loop=$("$@" liggghts -in in/bench.in -var wallfile in/wall_mesh.in -var stl stl/$tag.stl -var R $R \
-           -var state runs/$tag.packed.restart -var nsteps "$steps" | awk '/^Loop time/ {print $4}')
-  python3 -c "print($N*$steps/$loop)"
-}
 csv="$root/bench/results/liggghts_$size.csv"
 mkdir -p "$root/bench/results"
 echo "repeat,code,threads,particle_steps_per_s" > "$csv"
 for k in $(seq 1 "$repeats"); do
-  echo "$k,liggghts,1,$(liggghts_rate)" >> "$csv"
-  echo "$k,liggghts,2,$(liggghts_rate "${mpi[@]}")" >> "$csv"
+  echo "$k,liggghts,1,$(liggghts_rate stl/$tag.stl)" >> "$csv"
+  echo "$k,liggghts,2,$(liggghts_rate stl/$tag.stl "${mpi[@]}")" >> "$csv"
   "$root/build/diefill" bench liggghts --pack runs/$tag.packed.dump --stl stl/$tag.stl --steps "$steps" \
     --threads 1 --threads 2 --cache "$work/cache" --json "$work/diefill_${size}_$k.json" 2>/dev/null
   python3 - "$work/diefill_${size}_$k.json" "$k" >> "$csv" <<'PY'

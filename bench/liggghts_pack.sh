@@ -1,7 +1,8 @@
 # Sourced by the benchmarks (compare_liggghts.sh, scaling.sh) with $root and $size (5k or 50k)
 # set: installs what the reference scene of ../shared/bench/liggghts needs, builds diefill,
 # prepares the container STLs and the settled pack (by LIGGGHTS, once; kept under
-# out/bench/liggghts/runs), and leaves the shell in that work folder with R, H, N, tag set.
+# out/bench/liggghts/runs), and leaves the shell in that work folder with R, H, N, tag set and
+# liggghts_rate defined.
 ref="${DIEFILL_LIGGGHTS_DIR:-$root/../shared/bench/liggghts}"
 work="${DIEFILL_BENCH_WORK:-$root/out/bench/liggghts}"
 for p in liggghts openscad mpirun; do
@@ -23,3 +24,13 @@ if [[ ! -f runs/$tag.packed.dump ]]; then
   liggghts -in in/prep.in -var wallfile in/wall_mesh.in -var stl stl/$tag.stl -var R $R -var H $H -var N $N \
     -var insH $insH -var prepdt 5e-6 -var tag $tag -var maxsteps 200000 > prep_$tag.log
 fi
+
+# LIGGGHTS' particle-steps per second over $steps steps of the settled pack in the container STL
+# given, run by the launcher that follows it (none: one core; mpirun ...: ranks).
+liggghts_rate() {  # STL [launcher...]
+  local stl=$1 loop
+  shift
+  loop=$("$@" liggghts -in in/bench.in -var wallfile in/wall_mesh.in -var stl "$stl" -var R $R \
+           -var state runs/$tag.packed.restart -var nsteps "$steps" | awk '/^Loop time/ {print $4}')
+  python3 -c "print($N*$steps/$loop)"
+}

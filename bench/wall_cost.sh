@@ -27,9 +27,7 @@ case = json.load(open(sys.argv[1]))["cases"][0]
 print(f'{sys.argv[2]},diefill,{sys.argv[3]},{case["container_triangles"]},{case["runs"][0]["particle_steps_per_s"]}')
 PY
     [[ "$c" == struct1m ]] && continue  # LIGGGHTS 3.8 aborts at setup on it (../shared/bench/liggghts/README.md)
-    loop=$(liggghts -in in/bench.in -var wallfile in/wall_mesh.in -var stl "$stl" -var R $R \
-             -var state runs/$tag.packed.restart -var nsteps "$steps" | awk '/^Loop time/ {print $4}')
-    echo "$k,liggghts,$c,,$(python3 -c "print($N*$steps/$loop)")" >> "$csv"
+    echo "$k,liggghts,$c,,$(liggghts_rate "$stl")" >> "$csv"
   done
 done
 start=$(date +%s.%N)
