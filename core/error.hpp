@@ -19,10 +19,16 @@ class InputError : public std::runtime_error {
   std::string file_, field_, remedy_;
 };
 
-// The simulation stopped on a stability check: exit status 3.
+// The simulation stopped on a stability check: exit status 3. It carries the time step it was
+// stepping with, a property of the settings that a stopped run still has (the speed-accuracy
+// study charts it for every setting, stopped or not).
 class StabilityError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  StabilityError(const std::string& message, double time_step_s) : std::runtime_error(message), time_step_s_(time_step_s) {}
+  double time_step_s() const { return time_step_s_; }
+
+ private:
+  double time_step_s_;
 };
 
 enum ExitStatus : int { exit_ok = 0, exit_other = 1, exit_bad_input = 2, exit_unstable = 3, exit_interrupted = 130 };

@@ -62,7 +62,8 @@ LoopResult run_until(const dem::Model& model, dem::State& s, const LoopOptions& 
     if (report.status != dem::StepStatus::ok) {
       if (!o.checkpoint.empty()) dem::write_checkpoint(model, s, o.checkpoint);
       throw diefill::StabilityError(report.message +
-                                    (o.checkpoint.empty() ? "" : fmt::format(" (checkpoint: {})", o.checkpoint.string())));
+                                    (o.checkpoint.empty() ? "" : fmt::format(" (checkpoint: {})", o.checkpoint.string())),
+                                    model.dt);
     }
     if (interrupted(s, result.steps)) {
       if (!o.checkpoint.empty()) dem::write_checkpoint(model, s, o.checkpoint);

@@ -151,23 +151,21 @@ void coarse_graining(const PipelineScene& scene_in, bool reduced, Output& out) {
     const Powder powder = powder_of(s);
     const std::string label = fmt::format("coarse-graining: α = {:.3g} ({:.3g} mm)", f.alpha, f.diameter * 1e3);
 
-    std::vector<double> bed_rates;
+    std::vector<MeanAndError> bed_rates;
     std::vector<OutflowAngle> bed_angles;
     for (int bed = 0; bed < z.beds; ++bed) {
       Powder seeded = powder;
       seeded.seed += std::uint64_t(bed);
       const SlotRun slot = run_slot_container(seeded, box, fmt::format("{}, slot (bed {} of {})", label, bed + 1, z.beds));
       const LineFit flow = steady_rate(slot);
-      bed_rates.push_back(flow.slope);
-      f.rate_error = flow.slope_error;
+      bed_rates.push_back({flow.slope, flow.slope_error});
       f.bulk_density += slot.bulk_density / z.beds;
       f.slot_grains = slot.state.size();
       // The same columns for every factor: clear of the slot and the end wall by the coarsest grain.
       bed_angles.push_back(outflow_angle(slot.state, box, f.diameter, coarsest));
     }
-    const MeanAndError rate = mean_and_error(bed_rates);
-    f.rate = rate.mean;
-    if (z.beds > 1) f.rate_error = rate.error;
+    const MeanAndError rate = pooled(bed_rates);
+    f.rate = rate.mean, f.rate_error = rate.error;
     f.outflow = pooled(bed_angles);
     // The rate the real powder would give by the Beverloo law, from this one's.
     f.corrected_rate = f.rate * beverloo_slot(box.width, box.slot_width, beverloo_k, s.particle_diameter) /

@@ -122,9 +122,11 @@ void speed_accuracy(const PipelineScene& scene, bool reduced, Output& out) {
       cavity = field.field.cavity;
     } catch (const std::runtime_error& e) {
       // A setting the checks stop or refuse is a result of the sweep (StabilityError, InputError);
-      // the reference's own failure ends the study below.
+      // the reference's own failure ends the study below. A stopped run still had its time step,
+      // which the cost laws read.
       r.seconds = clock.seconds();
       r.stopped = e.what();
+      if (const auto* stop = dynamic_cast<const diefill::StabilityError*>(&e)) r.time_step = stop->time_step_s();
       diefill::log::warn("speed-accuracy: {}: stopped: {}", setting.label, e.what());
     }
     runs.push_back(r);

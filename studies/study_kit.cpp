@@ -79,6 +79,14 @@ MeanAndError mean_and_error(const std::vector<double>& x) {
   return m;
 }
 
+MeanAndError pooled(const std::vector<MeanAndError>& realisations) {
+  std::vector<double> values;
+  double fits = 0;
+  for (const MeanAndError& r : realisations) values.push_back(r.mean), fits += r.error * r.error;
+  const MeanAndError scatter = mean_and_error(values);
+  return {scatter.mean, std::max(scatter.error, std::sqrt(fits) / double(realisations.size()))};
+}
+
 LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y) {
   LineFit fit;
   fit.points = x.size();

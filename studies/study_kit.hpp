@@ -75,6 +75,12 @@ struct MeanAndError {
   double mean = 0, error = 0;
 };
 MeanAndError mean_and_error(const std::vector<double>& x);
+// Realisations of one experiment (beds of other seeds), each a value with its own standard
+// error: their mean, with the larger of the realisations' scatter and their own errors as its
+// error. One realisation's fit error hides the seed-to-seed scatter (repose heaps 1.6 mm:
+// fit errors 0.6-3°, the same powder's heaps 21.4-26.5° over six seeds), and two or three
+// realisations' scatter may by chance be smaller than their fits'.
+MeanAndError pooled(const std::vector<MeanAndError>& realisations);
 
 // One chart for postprocess/plots.py: series of points (with optional error bars) or lines.
 struct Series {

@@ -20,6 +20,9 @@ double grain_volume(double diameter) { return std::numbers::pi / 6 * diameter * 
 
 namespace {
 
+// Poured loose, the powder settles to a solid fraction of about 0.6 from 0.42.
+double pour_height(const SlotContainer& c) { return c.fill_height * 0.6 / 0.42; }
+
 dem::PlaneWall plane(const Vec3& point, const Vec3& normal, int material, const std::string& name) {
   return {point, normal, material, name};
 }
@@ -71,7 +74,10 @@ SlotContainer outflow_container(double d, bool reduced) {
   return c;
 }
 
-SlotRun run_slot_container(const Powder& p, const SlotContainer& c, const std::string& label) {
+namespace {
+
+// The container's walls, its floor's two plates beside the slot included, without the gate.
+dem::ModelSpec slot_walls(const Powder& p, const SlotContainer& c) {
   const double r = p.r_max(), d = p.diameter;
   const double half_l = 0.5 * c.length, half_w = 0.5 * c.width, floor = 2 * r;
   if (c.slot_width >= c.length - 4 * d)
@@ -87,36 +93,48 @@ SlotRun run_slot_container(const Powder& p, const SlotContainer& c, const std::s
                             p.wall, "floor -x"),
                  block_wall(Vec3(0.5 * c.slot_width, -half_w - past, -floor), Vec3(half_l + past, half_w + past, 0), r,
                             p.wall, "floor +x")};
-  const double pour_height = c.fill_height * 0.6 / 0.42;  // poured loose, settles to about 0.6
-  spec.domain = {Vec3(-half_l - past, -half_w - past, -floor - 4 * d), Vec3(half_l + past, half_w + past, pour_height + 10 * d)};
-  spec.max_impact_speed = std::max(spec.max_impact_speed, std::sqrt(2 * spec.gravity.norm() * pour_height));
+  spec.domain = {Vec3(-half_l - past, -half_w - past, -floor - 4 * d), Vec3(half_l + past, half_w + past, pour_height(c) + 10 * d)};
+  spec.max_impact_speed = std::max(spec.max_impact_speed, std::sqrt(2 * spec.gravity.norm() * pour_height(c)));
+  return spec;
+}
 
-  dem::ModelSpec gated = spec;
+}  // namespace
+
+SlotBed settle_slot_bed(const Powder& p, const SlotContainer& c, const std::string& label) {
+  const double r = p.r_max(), d = p.diameter;
+  const double half_l = 0.5 * c.length, half_w = 0.5 * c.width;
+  dem::ModelSpec gated = slot_walls(p, c);
   gated.planes.push_back(plane(Vec3::Zero(), Vec3::UnitZ(), p.wall, "gate"));
-  SlotRun run;
+  SlotBed bed;
   const auto wanted = std::size_t(c.length * c.width * c.fill_height * 0.6 / grain_volume(d));
   dem::InsertRegion region;
-  region.box = {Vec3(-half_l + r, -half_w + r, r), Vec3(half_l - r, half_w - r, pour_height)};
-  add_grains(run.state, region, p, wanted, p.seed);
-  const dem::Model shut = dem::compile_model(gated, run.state, p.source);
-  dem::initialize(shut, run.state);
-  advance(shut, run.state, c.settle_time, label + ": settling");
+  region.box = {Vec3(-half_l + r, -half_w + r, r), Vec3(half_l - r, half_w - r, pour_height(c))};
+  add_grains(bed.state, region, p, wanted, p.seed);
+  const dem::Model shut = dem::compile_model(gated, bed.state, p.source);
+  dem::initialize(shut, bed.state);
+  advance(shut, bed.state, c.settle_time, label + ": settling");
 
   // The bed: solid fraction of a slab well inside it, away from the walls and the surface.
-  run.bed_height = centre_height_quantile(run.state, 0.97);
-  const dem::Box3 core{Vec3(-half_l + 2 * d, -half_w + 2 * d, 2 * d), Vec3(half_l - 2 * d, half_w - 2 * d, run.bed_height - 2 * d)};
+  bed.bed_height = centre_height_quantile(bed.state, 0.97);
+  const dem::Box3 core{Vec3(-half_l + 2 * d, -half_w + 2 * d, 2 * d), Vec3(half_l - 2 * d, half_w - 2 * d, bed.bed_height - 2 * d)};
   double solid = 0;
-  for (std::size_t i = 0; i < run.state.size(); ++i)
-    if (core.contains(run.state.x[i])) solid += grain_volume(2 * run.state.radius[i]);
+  for (std::size_t i = 0; i < bed.state.size(); ++i)
+    if (core.contains(bed.state.x[i])) solid += grain_volume(2 * bed.state.radius[i]);
   const Vec3 core_size = core.hi - core.lo;
   if (core_size.minCoeff() <= 0)
     throw diefill::InputError(p.source, "fill_height", "leaves no bed to measure", "Give a container several grains deep");
-  run.bulk_density = p.density * solid / core_size.prod();
-  run.initial_mass = mass_where(run.state, [&](std::size_t i) { return run.state.active[i] != 0; });
+  bed.bulk_density = p.density * solid / core_size.prod();
+  bed.initial_mass = mass_where(bed.state, [&](std::size_t i) { return bed.state.active[i] != 0; });
+  return bed;
+}
 
+SlotRun drain_slot_bed(const Powder& p, const SlotContainer& c, SlotBed bed, const std::string& label) {
+  const double floor = 2 * p.r_max();
+  SlotRun run;
+  static_cast<SlotBed&>(run) = std::move(bed);
   // Open the gate.
   forget_wall_contacts(run.state);
-  const dem::Model open = dem::compile_model(spec, run.state, p.source);
+  const dem::Model open = dem::compile_model(slot_walls(p, c), run.state, p.source);
   dem::initialize(open, run.state);
   const double opened = run.state.time;
   const auto gone = [&](std::size_t i) { return !run.state.active[i] || run.state.x[i].z() < -floor; };
@@ -128,9 +146,16 @@ SlotRun run_slot_container(const Powder& p, const SlotContainer& c, const std::s
                                 run.time.push_back(s.time - opened);
                                 run.discharged.push_back(m);
                               }});
-  if (c.stop_when_drained) sampling.finished = [&](const dem::State& s) { return s.time - quiet_since > 0.1; };
+  sampling.finished = [&](const dem::State& s) {
+    return (c.stop_when_drained && s.time - quiet_since > 0.1) ||
+           (c.stop_after_steady_flow && run.discharged.back() > steady_flow_until_lost * run.initial_mass);
+  };
   advance(open, run.state, opened + c.flow_time, label, sampling);
   return run;
+}
+
+SlotRun run_slot_container(const Powder& p, const SlotContainer& c, const std::string& label) {
+  return drain_slot_bed(p, c, settle_slot_bed(p, c, label), label);
 }
 
 double beverloo_slot(double length, double width, double k, double d) {
@@ -140,7 +165,8 @@ double beverloo_slot(double length, double width, double k, double d) {
 LineFit steady_rate(const SlotRun& run) {
   std::vector<double> t, m;
   for (std::size_t i = 0; i < run.time.size(); ++i)
-    if (run.time[i] >= 0.05 && run.discharged[i] <= 0.4 * run.initial_mass) t.push_back(run.time[i]), m.push_back(run.discharged[i]);
+    if (run.time[i] >= steady_flow_transient && run.discharged[i] <= steady_flow_until_lost * run.initial_mass)
+      t.push_back(run.time[i]), m.push_back(run.discharged[i]);
   return fit_line(t, m);
 }
 
@@ -221,16 +247,11 @@ OutflowAngle outflow_angle(const dem::State& s, const SlotContainer& c, double d
 }
 
 OutflowAngle pooled(const std::vector<OutflowAngle>& beds) {
-  if (beds.size() == 1) return beds.front();
-  std::vector<double> angles, left, right;
-  double fits = 0;
-  for (const OutflowAngle& b : beds) {
-    angles.push_back(b.angle_deg), left.push_back(b.left_deg), right.push_back(b.right_deg);
-    fits += b.error_deg * b.error_deg;
-  }
-  const MeanAndError angle = mean_and_error(angles);
-  return {angle.mean, std::max(angle.error, std::sqrt(fits) / double(beds.size())), mean_and_error(left).mean,
-          mean_and_error(right).mean};
+  std::vector<MeanAndError> angles;
+  std::vector<double> left, right;
+  for (const OutflowAngle& b : beds) angles.push_back({b.angle_deg, b.error_deg}), left.push_back(b.left_deg), right.push_back(b.right_deg);
+  const MeanAndError angle = pooled(angles);
+  return {angle.mean, angle.error, mean_and_error(left).mean, mean_and_error(right).mean};
 }
 
 SurfaceFit fit_heap_surface(const dem::State& s, const Heap& h, double d) {

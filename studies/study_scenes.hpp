@@ -22,25 +22,35 @@ struct SlotContainer {
   double flow_time = 0.3;                         // [s] after opening, at most
   double sample_every = 2.5e-3;                   // [s]
   bool stop_when_drained = false;                 // end early once no grain has left for 0.1 s
+  bool stop_after_steady_flow = false;            // end once steady_rate has all it reads
 };
 
 // The container whose drained slopes give the outflow angle (and, while it drains, a flow rate):
 // a slot 6 grains wide, 10 (reduced) or 14 grains of floor beside it, run until no grain leaves.
 SlotContainer outflow_container(double diameter, bool reduced);
 
-struct SlotRun {
+// The powder poured into the container and settled on the shut gate.
+struct SlotBed {
+  double bulk_density = 0;  // of the settled bed [kg/m³]
+  double bed_height = 0;    // [m]
+  double initial_mass = 0;  // [kg]
+  dem::State state;         // settled; once drained, at the end
+};
+struct SlotRun : SlotBed {
   std::vector<double> time, discharged;  // since the opening [s]; mass below the floor or gone [kg]
-  double bulk_density = 0;               // of the settled bed [kg/m³]
-  double bed_height = 0;                 // [m]
-  double initial_mass = 0;               // [kg]
-  dem::State state;                      // at the end
 };
 
+// Settles a bed, then opens the gate over the slot.
 SlotRun run_slot_container(const Powder& powder, const SlotContainer& container, const std::string& label);
+// The two halves, for beds drained through several slots: the gate covers the whole floor, so
+// a bed settled in `container` drains through any slot of a container of its size.
+SlotBed settle_slot_bed(const Powder& powder, const SlotContainer& container, const std::string& label);
+SlotRun drain_slot_bed(const Powder& powder, const SlotContainer& container, SlotBed bed, const std::string& label);
 // The Beverloo slot law's geometry (L - k d)(b - k d)^{3/2} [m^{5/2}]: the rate over C_s rho_b sqrt(g).
 double beverloo_slot(double length, double width, double k, double d);
 // The steady discharge rate [kg/s]: a line through the discharged mass after the opening's
 // transient (50 ms) and before the bed has lost 40 % (its head then drops).
+inline constexpr double steady_flow_transient = 0.05, steady_flow_until_lost = 0.4;  // [s], of the bed's mass
 LineFit steady_rate(const SlotRun& run);
 
 struct Heap {
