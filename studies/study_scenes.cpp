@@ -255,27 +255,29 @@ OutflowAngle pooled(const std::vector<OutflowAngle>& beds) {
 }
 
 SurfaceFit fit_heap_surface(const dem::State& s, const Heap& h, double d) {
-  // Rings one grain wide, each the mean of the highest tops in eight sectors (the maximum over a
-  // whole ring would rise with its area); the toe and the apex, flattened under the stream, left out.
-  constexpr int sectors = 8;
+  // Square columns one grain wide, each its highest grain top against the radius of its centre,
+  // between the apex, flattened under the stream, and the toe. Columns of one area, so that the
+  // highest top is as far above the mean surface at every radius (the highest over a ring, or a
+  // sector of it, rises with its area, which grows with the radius). The reduced heap's four
+  // rings of eight sectors each gave the same powder's beds 18.8-24.9° where their ring profiles
+  // stood within a degree of each other; its ~150 columns read the slope of the whole flank.
   const double from = std::max(0.2 * h.pedestal_radius, h.stream_radius + d), to = 0.85 * h.pedestal_radius;
-  const auto rings = std::size_t(std::max(0.0, std::floor((to - from) / d)));
-  const std::vector<double> top = column_tops(s, rings * sectors, [&](const Vec3& x) {
-    const double radius = std::hypot(x.x(), x.y());
-    if (x.z() < 0 || radius < from || radius >= from + double(rings) * d) return -1L;
-    const double angle = std::atan2(x.y(), x.x()) + std::numbers::pi;
-    const long sector = std::min(sectors - 1L, long(angle / (2 * std::numbers::pi) * sectors));
-    return long(std::floor((radius - from) / d)) * sectors + sector;
-  });
+  const long half = long(std::ceil(to / d));
+  const long side = 2 * half;
+  const auto column_of = [&](const Vec3& x) {
+    const long i = long(std::floor(x.x() / d)) + half, j = long(std::floor(x.y() / d)) + half;
+    if (x.z() < 0 || i < 0 || j < 0 || i >= side || j >= side) return -1L;
+    return j * side + i;
+  };
+  const std::vector<double> top = column_tops(s, std::size_t(side * side), column_of);
   std::vector<double> position, height;
-  for (std::size_t k = 0; k < rings; ++k) {
-    double sum = 0;
-    int found = 0;
-    for (int j = 0; j < sectors; ++j)
-      if (std::isfinite(top[k * sectors + std::size_t(j)])) sum += top[k * sectors + std::size_t(j)], ++found;
-    position.push_back(from + (double(k) + 0.5) * d);
-    height.push_back(found == sectors ? sum / sectors : std::numeric_limits<double>::quiet_NaN());
-  }
+  for (long j = 0; j < side; ++j)
+    for (long i = 0; i < side; ++i) {
+      const double radius = std::hypot((double(i - half) + 0.5) * d, (double(j - half) + 0.5) * d);
+      if (radius < from || radius > to) continue;
+      position.push_back(radius);
+      height.push_back(top[std::size_t(j * side + i)]);
+    }
   return fit_surface(position, height);
 }
 
