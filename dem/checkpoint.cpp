@@ -14,8 +14,8 @@ namespace dem {
 
 namespace {
 
-constexpr char magic[8] = {'D', 'F', 'C', 'K', 'P', 'T', '0', '5'};
-constexpr char split_magic[8] = {'D', 'F', 'C', 'K', 'S', 'P', '0', '2'};
+constexpr char magic[8] = {'D', 'F', 'C', 'K', 'P', 'T', '0', '6'};
+constexpr char split_magic[8] = {'D', 'F', 'C', 'K', 'S', 'P', '0', '3'};
 
 struct Writer {
   std::string bytes;
@@ -98,6 +98,8 @@ void fields(IO& io, S& s) {
   io.value(s.energy_reference);
   io.value(s.energy_scale);
   io.value(s.energy_reference_set);
+  io.value(s.loop_max_overlap_rel);
+  io.value(s.loop_max_energy_gain);
 }
 
 // A run split over ranks, as one rank-count-free image: grains in id order with the forces of the
@@ -113,7 +115,7 @@ struct SlotRecord {
   WallSlot slot[wall_slots_per_particle];
 };
 struct SplitImage {
-  double time = 0, wall_work = 0, energy_reference = 0, energy_scale = 0;
+  double time = 0, wall_work = 0, energy_reference = 0, energy_scale = 0, loop_max_overlap_rel = 0, loop_max_energy_gain = 0;
   std::int64_t step = 0, lost = 0;
   std::uint8_t energy_reference_set = 0;
   std::vector<CheckpointGrain> grains;
@@ -131,6 +133,8 @@ void split_fields(IO& io, I& image) {
   io.value(image.step);
   io.value(image.lost);
   io.value(image.energy_reference_set);
+  io.value(image.loop_max_overlap_rel);
+  io.value(image.loop_max_energy_gain);
   io.array(image.grains);
   io.array(image.slots);
   io.array(image.pairs);
@@ -176,6 +180,7 @@ SplitImage image_of(const State& s) {
   image.time = s.time, image.wall_work = s.wall_work, image.step = s.step;
   image.energy_reference = s.energy_reference, image.energy_scale = s.energy_scale;
   image.energy_reference_set = s.energy_reference_set;
+  image.loop_max_overlap_rel = s.loop_max_overlap_rel, image.loop_max_energy_gain = s.loop_max_energy_gain;  // global on every rank
   image.lost = s.exchange ? s.exchange->sum(s.lost) : s.lost;
   std::vector<char> grains, slots, pairs;
   put_owned(s, grains, slots, pairs);
@@ -214,6 +219,7 @@ State share_of_image(const SplitImage& image, std::shared_ptr<Exchange> exchange
   s.lost = exchange->rank() == 0 ? image.lost : 0;
   s.energy_reference = image.energy_reference, s.energy_scale = image.energy_scale;
   s.energy_reference_set = image.energy_reference_set != 0;
+  s.loop_max_overlap_rel = image.loop_max_overlap_rel, s.loop_max_energy_gain = image.loop_max_energy_gain;
   s.exchange = std::move(exchange);
   return s;
 }

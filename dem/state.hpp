@@ -146,6 +146,10 @@ struct State {
   double energy_reference = 0;  // mechanical energy at initialize() [J]
   double energy_scale = 0;      // Σ m g r: the energy of a grain-radius drop of every grain [J]
   bool energy_reference_set = false;
+  // The largest overlap over the radius and the largest energy gain of the run loop so far
+  // (pipeline/run_loop.hpp), here so that a checkpoint carries them: a resumed run reports its
+  // whole run, not only what followed the resume.
+  double loop_max_overlap_rel = 0, loop_max_energy_gain = 0;
 
   std::size_t size() const { return x.size(); }
   std::size_t owned() const { return x.size() - ghosts; }

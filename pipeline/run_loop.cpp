@@ -43,6 +43,8 @@ LoopResult run_until(const dem::Model& model, dem::State& s, const LoopOptions& 
   const double start = s.time;
   std::vector<double> next_output(o.outputs.size(), s.time);
   const std::int64_t grains = s.exchange ? s.exchange->sum(std::int64_t(s.owned())) : std::int64_t(s.size());
+  if (!o.resumed) s.loop_max_overlap_rel = s.loop_max_energy_gain = 0;
+  result.max_overlap_rel = s.loop_max_overlap_rel, result.max_energy_gain = s.loop_max_energy_gain;
   while (s.time < o.until - 0.5 * model.dt) {
     bool output = false;
     for (std::size_t k = 0; k < o.outputs.size(); ++k)
@@ -57,8 +59,9 @@ LoopResult run_until(const dem::Model& model, dem::State& s, const LoopOptions& 
     }
     const dem::StepReport report = dem::step(model, s, &result.times);
     ++result.steps;
-    result.max_overlap_rel = std::max(result.max_overlap_rel, s.counters.max_overlap_rel);
-    result.max_energy_gain = std::max(result.max_energy_gain, s.counters.energy_gain);
+    s.loop_max_overlap_rel = std::max(s.loop_max_overlap_rel, s.counters.max_overlap_rel);
+    s.loop_max_energy_gain = std::max(s.loop_max_energy_gain, s.counters.energy_gain);
+    result.max_overlap_rel = s.loop_max_overlap_rel, result.max_energy_gain = s.loop_max_energy_gain;
     if (report.status != dem::StepStatus::ok) {
       if (!o.checkpoint.empty()) dem::write_checkpoint(model, s, o.checkpoint);
       throw diefill::StabilityError(report.message +

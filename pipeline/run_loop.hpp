@@ -29,6 +29,8 @@ struct LoopOptions {
   std::function<bool(const dem::State&)> finished;
   // Extra words for the progress line (grains in the cavity, ...).
   std::function<std::string(const dem::State&)> detail;
+  // The state comes from this loop's checkpoint: its maxima so far carry on (LoopResult).
+  bool resumed = false;
 };
 
 struct LoopResult {

@@ -63,6 +63,7 @@ std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& wal
   loop.until = shoe.t_motion + s.die_settle_time;
   loop.label = walls.die.name + ": filling";
   loop.checkpoint = checkpoint;
+  loop.resumed = resume && found;
   std::vector<double> snapshot_times;
   if (s.snapshot_every > 0)
     loop.outputs.push_back({s.snapshot_every, [&](const dem::State& st) {
