@@ -44,7 +44,6 @@ LoopResult run_until(const dem::Model& model, dem::State& s, const LoopOptions& 
   std::vector<double> next_output(o.outputs.size(), s.time);
   const std::int64_t grains = s.exchange ? s.exchange->sum(std::int64_t(s.owned())) : std::int64_t(s.size());
   if (!o.resumed) s.loop_max_overlap_rel = s.loop_max_energy_gain = 0;
-  result.max_overlap_rel = s.loop_max_overlap_rel, result.max_energy_gain = s.loop_max_energy_gain;
   while (s.time < o.until - 0.5 * model.dt) {
     bool output = false;
     for (std::size_t k = 0; k < o.outputs.size(); ++k)
@@ -61,7 +60,6 @@ LoopResult run_until(const dem::Model& model, dem::State& s, const LoopOptions& 
     ++result.steps;
     s.loop_max_overlap_rel = std::max(s.loop_max_overlap_rel, s.counters.max_overlap_rel);
     s.loop_max_energy_gain = std::max(s.loop_max_energy_gain, s.counters.energy_gain);
-    result.max_overlap_rel = s.loop_max_overlap_rel, result.max_energy_gain = s.loop_max_energy_gain;
     if (report.status != dem::StepStatus::ok) {
       if (!o.checkpoint.empty()) dem::write_checkpoint(model, s, o.checkpoint);
       throw diefill::StabilityError(report.message +
@@ -81,6 +79,7 @@ LoopResult run_until(const dem::Model& model, dem::State& s, const LoopOptions& 
   }
   if (!result.interrupted && !result.finished_early)
     for (const Periodic& p : o.outputs) p.action(s);
+  result.max_overlap_rel = s.loop_max_overlap_rel, result.max_energy_gain = s.loop_max_energy_gain;
   result.wall_s = clock.seconds();
   progress.finish(fmt::format("{} steps, {:.3g} particle-steps/s", result.steps,
                               double(result.steps) * double(grains) / std::max(1e-9, result.wall_s)));
