@@ -2,7 +2,9 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <utility>
+#include <vector>
 
 #include "dem/walls.hpp"
 
@@ -234,6 +236,8 @@ void pair_forces(const Model& model, State& s) {
   s.counters.contacts = contacts;
 }
 
+constexpr std::size_t wall_prefetch_distance = 4;
+
 template <class Law>
 [[gnu::flatten]] void wall_forces(const Model& model, State& s) {
   const Array<std::int32_t>& near = s.neighbours.near_wall;
@@ -247,6 +251,13 @@ template <class Law>
 #pragma omp parallel for schedule(static) reduction(max : max_overlap) reduction(+ : contacts)
   for (std::size_t q = 0; q < near.size(); ++q) {
     const std::size_t i = std::size_t(near[q]);
+    // The faces a few grains ahead are fetched while this grain is queried: on a finely
+    // tessellated wall each grain's faces are its own, and the query would wait on them.
+    if (const std::size_t ahead = q + wall_prefetch_distance; walls && ahead < near.size())
+      for (std::size_t m = 0; m < walls; ++m) {
+        const WallCandidates& c = s.wall_candidates[ahead * walls + m];
+        model.meshes[m].field->prefetch(c.triangles, c.count);
+      }
     if (!s.active[i]) continue;
     WallHit hits[wall_slots_per_particle];
     const int count = wall_hits(model, s.time, s.x[i], s.radius[i], hits, wall_slots_per_particle,
@@ -378,9 +389,17 @@ double elastic_energy(const Model& model, const State& s) {
         total += (j < s.owned() ? 1.0 : 0.5) *
                  energy(model.params(s.material[i], s.material[j]), s.radius[i] * s.radius[j] / reach, overlap);
     }
-  for (std::int32_t i : nl.near_wall) {
+  // The wall queries start from copies of the grains' tracked seeds (the state stays as it is):
+  // from the voxel corners they would walk over a voxel's worth of fine triangles each.
+  const std::size_t walls = model.meshes.size();
+  const bool tracked = walls > 0 && s.wall_candidates.size() == nl.near_wall.size() * walls;
+  std::vector<WallCandidates> seeds(walls);
+  for (std::size_t q = 0; q < nl.near_wall.size(); ++q) {
+    const std::int32_t i = nl.near_wall[q];
+    if (tracked) std::copy_n(&s.wall_candidates[q * walls], walls, seeds.begin());
     WallHit hits[wall_slots_per_particle];
-    const int count = wall_hits(model, s.time, s.x[std::size_t(i)], s.radius[std::size_t(i)], hits, wall_slots_per_particle);
+    const int count = wall_hits(model, s.time, s.x[std::size_t(i)], s.radius[std::size_t(i)], hits, wall_slots_per_particle,
+                                tracked ? seeds.data() : nullptr);
     for (int k = 0; k < count; ++k) {
       const int wm = hits[k].wall < std::int32_t(model.planes.size())
                          ? model.planes[std::size_t(hits[k].wall)].material

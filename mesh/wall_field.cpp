@@ -32,28 +32,31 @@ void WallField::set_surface(const TriMesh& mesh) {
   vertices = mesh.vertices;
   triangles = mesh.triangles;
   const std::size_t nt = triangles.size(), nv = vertices.size();
-  face_normals.resize(nt);
-  neighbours.assign(nt, {-1, -1, -1});
+  faces.resize(nt);
   vertex_normals.assign(nv, Vec3::Zero());
   std::map<std::pair<int, int>, std::pair<int, int>> edge_owner;  // directed edge -> (face, k)
   std::vector<int> degree(nv, 0);
   for (std::size_t t = 0; t < nt; ++t) {
     const Triangle& tri = triangles[t];
+    WallFace& face = faces[t];
     const Vec3 n = (vertices[tri[1]] - vertices[tri[0]]).cross(vertices[tri[2]] - vertices[tri[0]]);
-    face_normals[t] = n.norm() > 0 ? Vec3(n.normalized()) : Vec3::UnitZ();
+    face.normal = n.norm() > 0 ? Vec3(n.normalized()) : Vec3::UnitZ();
+    face.vertex = tri;
+    face.neighbour = {-1, -1, -1};
     for (int k = 0; k < 3; ++k) {
+      face.corner[std::size_t(k)] = vertices[tri[k]];
       edge_owner[{tri[k], tri[(k + 1) % 3]}] = {int(t), k};
       ++degree[tri[k]];
       // Angle-weighted vertex pseudo-normal.
       const Vec3 e1 = (vertices[tri[(k + 1) % 3]] - vertices[tri[k]]).normalized();
       const Vec3 e2 = (vertices[tri[(k + 2) % 3]] - vertices[tri[k]]).normalized();
-      vertex_normals[tri[k]] += std::acos(std::clamp(e1.dot(e2), -1.0, 1.0)) * face_normals[t];
+      vertex_normals[tri[k]] += std::acos(std::clamp(e1.dot(e2), -1.0, 1.0)) * face.normal;
     }
   }
   for (std::size_t t = 0; t < nt; ++t)
     for (int k = 0; k < 3; ++k) {
       auto it = edge_owner.find({triangles[t][(k + 1) % 3], triangles[t][k]});
-      if (it != edge_owner.end()) neighbours[t][k] = it->second.first;
+      if (it != edge_owner.end()) faces[t].neighbour[std::size_t(k)] = it->second.first;
     }
   for (Vec3& n : vertex_normals)
     if (n.norm() > 0) n.normalize();
@@ -66,7 +69,7 @@ void WallField::set_surface(const TriMesh& mesh) {
 }
 
 std::size_t WallField::memory_bytes() const {
-  return vertices.size() * sizeof(Vec3) * 2 + triangles.size() * (sizeof(Triangle) * 2 + sizeof(Vec3)) +
+  return vertices.size() * sizeof(Vec3) * 2 + triangles.size() * (sizeof(Triangle) + sizeof(WallFace)) +
          vertex_faces.size() * sizeof(int) + brick_of_cell.size() * 4 + distance.size() * 4 +
          closest.size() * 4;
 }
@@ -127,8 +130,8 @@ const double same_surface = std::cos(smooth_angle_deg * 3.14159265358979323846 /
 
 SurfacePoint WallField::descend(const Vec3& p, int start, int* anchor, bool stop_at_sharp_edge) const {
   auto closest_on = [&](int t) {
-    const Triangle& tri = triangles[std::size_t(t)];
-    return closest_feature(p, vertices[tri[0]], vertices[tri[1]], vertices[tri[2]]);
+    const WallFace& face = faces[std::size_t(t)];
+    return closest_feature(p, face.corner[0], face.corner[1], face.corner[2]);
   };
   int current = start;
   ClosestPoint cp = closest_on(current);
@@ -147,16 +150,16 @@ SurfacePoint WallField::descend(const Vec3& p, int start, int* anchor, bool stop
       if (e2 < best_d2) best = t, best_cp = c, best_d2 = e2;
     };
     if (cp.feature == Feature::edge) {
-      consider(neighbours[std::size_t(current)][std::size_t(cp.index)]);
+      consider(faces[std::size_t(current)].neighbour[std::size_t(cp.index)]);
     } else {
-      const int v = triangles[std::size_t(current)][std::size_t(cp.index)];
+      const int v = faces[std::size_t(current)].vertex[std::size_t(cp.index)];
       const int* fan = &vertex_faces[std::size_t(vertex_face_offsets[std::size_t(v)])];
       const int* fan_end = &vertex_faces[0] + vertex_face_offsets[std::size_t(v) + 1];
       if (stop_at_sharp_edge) {
         // Watching a surface: a closer face of it moves the walk on; failing that, the first
         // closer face across a sharp edge ends the walk. A vertex where a fine cap meets a wall
         // may hold a hundred faces, and the watch is asked at every step.
-        const auto smooth = [&](int t) { return face_normals[std::size_t(current)].dot(face_normals[std::size_t(t)]) > same_surface; };
+        const auto smooth = [&](int t) { return faces[std::size_t(current)].normal.dot(faces[std::size_t(t)].normal) > same_surface; };
         for (const int* f = fan; f < fan_end; ++f)
           if (smooth(*f)) consider(*f);
         for (const int* f = fan; f < fan_end && best < 0; ++f)
@@ -166,7 +169,7 @@ SurfacePoint WallField::descend(const Vec3& p, int start, int* anchor, bool stop
       }
     }
     if (best < 0) break;
-    if (anchor && *anchor < 0 && face_normals[std::size_t(current)].dot(face_normals[std::size_t(best)]) <= same_surface) {
+    if (anchor && *anchor < 0 && faces[std::size_t(current)].normal.dot(faces[std::size_t(best)].normal) <= same_surface) {
       *anchor = current;
       if (stop_at_sharp_edge) break;
     }
@@ -178,31 +181,34 @@ SurfacePoint WallField::descend(const Vec3& p, int start, int* anchor, bool stop
   // The result is computed from the feature alone, whichever triangle the walk reached it by, so
   // that walks from different seeds give the same minimum bit for bit (and a tracked query the
   // result of a fresh one).
-  const Triangle& tri = triangles[std::size_t(current)];
+  const WallFace& face = faces[std::size_t(current)];
   SurfacePoint out;
   out.point = cp.point;
   out.triangle = current;
-  Vec3 pseudo_normal = face_normals[std::size_t(current)];
+  Vec3 pseudo_normal = face.normal;
   switch (cp.feature) {
     case Feature::face:
       out.feature = std::uint64_t(current);
       break;
     case Feature::edge: {
-      const int a = std::min(tri[std::size_t(cp.index)], tri[std::size_t(cp.index + 1) % 3]);
-      const int b = std::max(tri[std::size_t(cp.index)], tri[std::size_t(cp.index + 1) % 3]);
+      // The edge from its lower-numbered vertex, whichever face the walk ended on.
+      const std::size_t k = std::size_t(cp.index), k1 = std::size_t(cp.index + 1) % 3;
+      const bool forward = face.vertex[k] < face.vertex[k1];
+      const int a = forward ? face.vertex[k] : face.vertex[k1], b = forward ? face.vertex[k1] : face.vertex[k];
+      const Vec3& from = face.corner[forward ? k : k1];
       out.feature = (1ull << 62) | (std::uint64_t(a) << 31) | std::uint64_t(b);
-      const Vec3 ab = vertices[std::size_t(b)] - vertices[std::size_t(a)];
+      const Vec3 ab = face.corner[forward ? k1 : k] - from;
       const double length2 = ab.squaredNorm();  // zero on an edge of coincident vertices
-      out.point = vertices[std::size_t(a)] + (length2 > 0 ? std::clamp((p - vertices[std::size_t(a)]).dot(ab) / length2, 0.0, 1.0) : 0.0) * ab;
-      const int n = neighbours[std::size_t(current)][std::size_t(cp.index)];
+      out.point = from + (length2 > 0 ? std::clamp((p - from).dot(ab) / length2, 0.0, 1.0) : 0.0) * ab;
+      const int n = face.neighbour[k];
       if (n >= 0) {
         out.triangle = std::min(current, n);
-        pseudo_normal = face_normals[std::size_t(out.triangle)] + face_normals[std::size_t(std::max(current, n))];
+        pseudo_normal = faces[std::size_t(out.triangle)].normal + faces[std::size_t(std::max(current, n))].normal;
       }
       break;
     }
     case Feature::vertex: {
-      const int v = tri[std::size_t(cp.index)];
+      const int v = face.vertex[std::size_t(cp.index)];
       out.feature = (2ull << 62) | std::uint64_t(v);
       out.triangle = vertex_faces[std::size_t(vertex_face_offsets[std::size_t(v)])];  // the lowest: faces are listed ascending
       pseudo_normal = vertex_normals[std::size_t(v)];

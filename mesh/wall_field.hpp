@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/huge_pages.hpp"
 #include "mesh/trimesh.hpp"
 
 namespace mesh {
@@ -41,16 +42,31 @@ struct SurfacePoint {
 // mesh::sharp_edges uses the same figure).
 inline constexpr double smooth_angle_deg = 30.0;
 
+// What a wall query reads of one triangle, in one record of two cache lines: a query near a
+// finely tessellated wall touches triangles no other grain touches, and reading the corners,
+// normal and neighbours from five arrays cost a cache miss each (the wall stage ran 1.7 times
+// slower on a million triangles than on 4,092 with the same tests per query).
+struct alignas(64) WallFace {
+  std::array<Vec3, 3> corner;       // [m]
+  Vec3 normal;                      // unit, outward
+  Triangle vertex;                  // indices into WallField::vertices
+  std::array<int, 3> neighbour;     // across local edge k (corner k to k+1); -1 on a boundary
+};
+
+// What the queries read at random, grain by grain: on huge pages when large (a million-triangle
+// wall's faces span 128 MB).
+template <class T>
+using QueryArray = std::vector<T, diefill::HugePageAllocator<T>>;
+
 struct WallField {
   // Surface (metres), with adjacency for the local descent and angle-weighted pseudo-normals
   // for the sign (Bærentzen & Aanæs 2005).
   std::vector<Vec3> vertices;
   std::vector<Triangle> triangles;
-  std::vector<Vec3> face_normals;
-  std::vector<std::array<int, 3>> neighbours;  // across local edge k; -1 on a boundary
-  std::vector<Vec3> vertex_normals;            // angle-weighted
-  std::vector<int> vertex_face_offsets;        // CSR: faces around each vertex
-  std::vector<int> vertex_faces;
+  QueryArray<WallFace> faces;                  // per triangle, what the queries read
+  QueryArray<Vec3> vertex_normals;             // angle-weighted
+  QueryArray<int> vertex_face_offsets;         // CSR: faces around each vertex
+  QueryArray<int> vertex_faces;
 
   // Sparse voxels: bricks of 8x8x8 voxels; voxel (i, j, k) sits at (i, j, k) * voxel.
   double voxel = 0.0;                    // [m]
@@ -59,9 +75,9 @@ struct WallField {
   float free_band = 0.0f;                // [m]
   float solid_band = 0.0f;               // [m]
   std::array<int, 3> brick_min{}, brick_count{};  // dense brick index box, in bricks
-  std::vector<std::int32_t> brick_of_cell;  // >= 0: brick; -1: no brick, outside; -2: inside
-  std::vector<float> distance;           // 512 per brick [m]
-  std::vector<std::int32_t> closest;     // 512 per brick; -1 where the voxel is not in the band
+  QueryArray<std::int32_t> brick_of_cell;  // >= 0: brick; -1: no brick, outside; -2: inside
+  QueryArray<float> distance;           // 512 per brick [m]
+  QueryArray<std::int32_t> closest;     // 512 per brick; -1 where the voxel is not in the band
 
   std::size_t memory_bytes() const;
 
@@ -87,6 +103,15 @@ struct WallField {
   // order of their features.
   int local_minima_tracked(const Vec3& p, double range, std::int32_t* seeds, std::int32_t& count,
                            SurfacePoint* out, int capacity) const;
+  // Asks the memory for the faces a tracked query will start from (seeds as above), so that a
+  // loop over grains can fetch the next grains' faces while it queries this one's.
+  void prefetch(const std::int32_t* seeds, std::int32_t count) const {
+    for (std::int32_t c = 0; c < count; ++c) {
+      const char* face = reinterpret_cast<const char*>(&faces[std::size_t(seeds[c] < 0 ? ~seeds[c] : seeds[c])]);
+      __builtin_prefetch(face);
+      __builtin_prefetch(face + 64);
+    }
+  }
   // Integer coordinates of the voxel cell containing p, and the distinct closest triangles of
   // its eight corners (at most 8).
   std::array<int, 3> cell_of(const Vec3& p) const;
