@@ -256,7 +256,7 @@ template <class Law>
     if (const std::size_t ahead = q + wall_prefetch_distance; walls && ahead < near.size())
       for (std::size_t m = 0; m < walls; ++m) {
         const WallCandidates& c = s.wall_candidates[ahead * walls + m];
-        model.meshes[m].field->prefetch(c.triangles, c.count);
+        model.meshes[m].field->prefetch(c.triangles, &c.count);
       }
     if (!s.active[i]) continue;
     WallHit hits[wall_slots_per_particle];

@@ -18,6 +18,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <functional>
 #include <map>
 #include <numeric>
 #include <optional>
@@ -520,7 +521,8 @@ RepairResult repair(const TriMesh& input, const RepairOptions& options, const st
                                     before.boundary_edges, mm(largest_open_hole)));
       if (before.non_manifold_edges > 0)
         parts.push_back(fmt::format("{} non-manifold edges", before.non_manifold_edges));
-      if (const std::size_t crossing = detail::count_self_intersections(repaired); crossing > 0)
+      if (const std::size_t crossing = unchanged(repaired) ? before.self_intersections : detail::count_self_intersections(repaired);
+          crossing > 0)
         parts.push_back(fmt::format("{} pairs of intersecting triangles", crossing));
       if (!parts.empty()) defect += " (" + fmt::format("{}", fmt::join(parts, "; ")) + ")";
     }

@@ -52,6 +52,7 @@ struct alignas(64) WallFace {
   Triangle vertex;                  // indices into WallField::vertices
   std::array<int, 3> neighbour;     // across local edge k (corner k to k+1); -1 on a boundary
 };
+static_assert(sizeof(WallFace) == 128, "two cache lines: WallField::prefetch fetches both");
 
 // What the queries read at random, grain by grain: on huge pages when large (a million-triangle
 // wall's faces span 128 MB).
@@ -105,9 +106,14 @@ struct WallField {
                            SurfacePoint* out, int capacity) const;
   // Asks the memory for the faces a tracked query will start from (seeds as above), so that a
   // loop over grains can fetch the next grains' faces while it queries this one's.
-  void prefetch(const std::int32_t* seeds, std::int32_t count) const {
-    for (std::int32_t c = 0; c < count; ++c) {
-      const char* face = reinterpret_cast<const char*>(&faces[std::size_t(seeds[c] < 0 ? ~seeds[c] : seeds[c])]);
+  // The seeds may be another thread's, being written as they are read (the grains ahead of a
+  // thread's share are the next thread's first): read atomically, any value read is a valid seed
+  // and a count from -1 to 8, and a prefetch changes no result.
+  void prefetch(const std::int32_t* seeds, const std::int32_t* count) const {
+    const std::int32_t n = __atomic_load_n(count, __ATOMIC_RELAXED);
+    for (std::int32_t c = 0; c < n; ++c) {
+      const std::int32_t seed = __atomic_load_n(&seeds[c], __ATOMIC_RELAXED);
+      const char* face = reinterpret_cast<const char*>(&faces[std::size_t(seed < 0 ? ~seed : seed)]);
       __builtin_prefetch(face);
       __builtin_prefetch(face + 64);
     }
