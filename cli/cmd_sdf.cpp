@@ -14,15 +14,18 @@ int run_sdf(const SdfCommand& c) {
   mesh::DieOptions options = mesh::die_options_for_grains(
       c.grain_radius_mm * mm, c.skin_mm * mm,
       c.voxel_mm ? std::optional<double>(*c.voxel_mm * mm) : std::nullopt);
-  options.unit = mesh::parse_unit(c.units, "--units");
   options.role = mesh::parse_role(c.role, "--role");
   options.up = mesh::parse_up(c.up, "--up");
   if (c.tolerance_mm) options.repair.tolerance_m = *c.tolerance_mm * mm;
   if (c.max_hole_mm) options.repair.max_hole_m = *c.max_hole_mm * mm;
   options.table_margin_m = c.table_margin_mm * mm;
 
-  const mesh::PreparedDie die = mesh::prepare_die(c.mesh, options, std::nullopt);
-  fmt::print("mesh {} ({} units: {})\n", die.source, mesh::unit_name(options.unit), die.sha256);
+  const mesh::DieFile file =
+      mesh::read_die_file(c.mesh, mesh::parse_unit_or_auto(c.units, "--units"), mesh::up_to_read(options));
+  options.unit = file.unit;
+  const mesh::PreparedDie die = mesh::prepare_die(file, options, std::nullopt);
+  fmt::print("mesh {} ({} units{}: {})\n", die.source, mesh::unit_name(options.unit),
+             file.unit_guessed ? ", guessed from its size; --units chooses" : "", die.sha256);
   if (die.up != mesh::Up{})
     fmt::print("orientation: the opening faces {} in the file ({}); turned so that it faces +z\n", mesh::up_name(die.up),
                die.up_found ? "found: its largest flat face at an extreme; --up chooses" : "--up");

@@ -14,7 +14,7 @@ std::string version_text();
 struct SdfCommand {
   std::filesystem::path mesh;
   std::filesystem::path output;
-  std::string units = "mm";
+  std::string units = "auto";
   std::string role = "cavity";
   std::string up = "auto";  // the way a cavity's opening faces in the file
   std::optional<double> voxel_mm;

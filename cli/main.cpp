@@ -15,7 +15,8 @@ void add_sdf(CLI::App& root, app::SdfCommand& c, std::function<int()>& action) {
   cmd->add_option("MESH", c.mesh, "Mesh file (STL, OBJ, PLY, OFF, ...)")->required();
   cmd->add_option("-o,--output", c.output, "Output .vdb file");
   cmd->add_option("--voxel", c.voxel_mm, "Voxel edge [mm] (default: a quarter of the grain radius)");
-  cmd->add_option("--units", c.units, "Length unit of the file: mm, m or in")->capture_default_str();
+  cmd->add_option("--units", c.units, "Length unit of the file: mm, m, in, or auto (guessed from its size)")
+      ->capture_default_str();
   cmd->add_option("--up", c.up, "The way a cavity's opening faces in the file: +x, -x, +y, -y, +z, -z, or auto (found)")
       ->capture_default_str();
   cmd->add_option("--role", c.role, "cavity (the part, open at the table), tool (the die body) or container (a closed vessel)")
@@ -38,7 +39,7 @@ void add_run(CLI::App& root, app::RunCommand& c, std::function<int()>& action) {
   cmd->add_option("--threads", c.threads, "Threads (default: all cores); results do not depend on it");
   cmd->add_option("--seed", c.seed, "Random seed of the powder");
   cmd->add_option("--up", c.up, "The way the die's opening faces in its file: +x, -x, +y, -y, +z, -z or auto (die.up)");
-  cmd->add_option("--units", c.units, "Length unit of the die's file: mm, m or in (die.units)");
+  cmd->add_option("--units", c.units, "Length unit of the die's file: mm, m, in, or auto (die.units)");
   cmd->add_flag("--resume", c.resume, "Continue an interrupted run from its checkpoint");
   cmd->add_option("--sweep", c.sweep,
                   "Run once per value of a scene key, each into OUT/KEY=VALUE/, with a summary table and chart: "

@@ -147,13 +147,15 @@ std::string die_cache_key(const std::string& file_sha256, Up up, const DieOption
   return diefill::sha256_hex(text);
 }
 
-DieFile read_die_file(const fs::path& path, LengthUnit unit, std::optional<Up> up) {
+DieFile read_die_file(const fs::path& path, std::optional<LengthUnit> unit, std::optional<Up> up) {
   DieFile file;
   file.source = path.string();
   file.name = path.stem().string();
-  file.unit = unit;
   // Import first: it gives the clear message for a missing, empty or unreadable file.
-  file.mesh = import_mesh(path, {unit}).mesh;
+  ImportResult imported = import_mesh(path, {unit});
+  file.unit = imported.unit;
+  file.unit_guessed = imported.unit_guessed;
+  file.mesh = std::move(imported.mesh);
   file.sha256 = diefill::sha256_file(path);
   file.up_found = !up;
   file.up = up ? *up : find_opening(file.mesh, file.source);
@@ -161,9 +163,12 @@ DieFile read_die_file(const fs::path& path, LengthUnit unit, std::optional<Up> u
   return file;
 }
 
+std::optional<Up> up_to_read(const DieOptions& options) {
+  return options.up || options.role == WallRole::cavity ? options.up : Up{};
+}
+
 PreparedDie prepare_die(const fs::path& path, const DieOptions& options, const std::optional<fs::path>& cache_dir) {
-  const std::optional<Up> up = options.up || options.role == WallRole::cavity ? options.up : Up{};
-  return prepare_die(read_die_file(path, options.unit, up), options, cache_dir);
+  return prepare_die(read_die_file(path, options.unit, up_to_read(options)), options, cache_dir);
 }
 
 PreparedDie prepare_die(const DieFile& file, const DieOptions& options, const std::optional<fs::path>& cache_dir) {
@@ -179,6 +184,8 @@ PreparedDie prepare_die(const DieFile& file, const DieOptions& options, const st
   out.sha256 = file.sha256;
   out.up = file.up;
   out.up_found = file.up_found;
+  out.unit = file.unit;
+  out.unit_guessed = file.unit_guessed;
   out.cache_key = die_cache_key(out.sha256, file.up, options);
 
   if (cache_dir) {

@@ -44,6 +44,8 @@ struct PreparedDie {
   std::string name;    // file stem
   std::string source;  // path as given
   std::string sha256;  // of the file's bytes
+  LengthUnit unit = LengthUnit::mm;  // the file's
+  bool unit_guessed = false;         // from its size, not given
   Up up;               // the way its opening faced in the file (now +z)
   bool up_found = false;  // found by looking, not given
   MeshReport before, after;          // checks before and after repair
@@ -66,13 +68,19 @@ struct DieFile {
   std::string source;  // path as given
   std::string sha256;  // of the file's bytes
   LengthUnit unit = LengthUnit::mm;
+  bool unit_guessed = false;  // from its size (guess_unit), not given
   Up up;                  // the way its opening faced in the file; the mesh is turned to face +z
   bool up_found = false;  // found by looking, not given
   TriMesh mesh;        // [m]
 };
-// Reads the file and turns it so that its opening faces +z (`up` unset: find_opening). Throws
-// InputError for a missing, empty or unreadable file.
-DieFile read_die_file(const std::filesystem::path& path, LengthUnit unit, std::optional<Up> up = Up{});
+// Reads the file in `unit` (unset: guessed from its size, with a warning) and turns it so that
+// its opening faces +z (`up` unset: find_opening). Throws InputError for a missing, empty or
+// unreadable file.
+DieFile read_die_file(const std::filesystem::path& path, std::optional<LengthUnit> unit, std::optional<Up> up = Up{});
+
+// The `up` to read a die's file with: the options' own, or for a cavity unset (its opening is
+// found); a tool or a container is not turned.
+std::optional<Up> up_to_read(const DieOptions& options);
 
 // Throws InputError for every defect of the file or the options (a die smaller than a few
 // voxels, for instance, usually a mesh in metres read as millimetres).

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include "mesh/geometry.hpp"
 #include "mesh/versions.hpp"
@@ -42,7 +43,9 @@ struct ExactSurface::Impl {
     return false;
   }
 
-  int crossings(const Vec3& origin, const Vec3& direction) const {
+  // Faces the ray from `origin` crosses: all of them, or with `signed_by_face` those it leaves
+  // through (along their outward normal) minus those it enters through.
+  int crossings(const Vec3& origin, const Vec3& direction, bool signed_by_face = false) const {
     int count = 0;
     float tnear = 0.0f;
     const Vec3 o = origin - centre;
@@ -62,7 +65,13 @@ struct ExactSurface::Impl {
       rtcInitIntersectContext(&context);
       rtcIntersect1(scene, &context, &rh);
       if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
-      ++count;
+      if (signed_by_face) {
+        const Triangle& t = mesh.triangles[rh.hit.primID];
+        const Vec3 outward = (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
+        count += outward.dot(direction) > 0 ? 1 : -1;
+      } else {
+        ++count;
+      }
       tnear = std::nextafter(rh.ray.tfar, std::numeric_limits<float>::infinity()) +
               1e-7f * std::max(1.0f, rh.ray.tfar);
     }
@@ -130,6 +139,17 @@ bool ExactSurface::inside(const Vec3& p) const {
   int votes = 0;
   for (const Vec3& d : directions) votes += impl_->crossings(p, d) % 2;
   return (votes >= 2) != impl_->inside_out;
+}
+
+bool ExactSurface::inside_by_ray_majority(const Vec3& p, int rays) const {
+  std::mt19937_64 random(7);
+  std::normal_distribution<double> normal;
+  int votes = 0;
+  for (int r = 0; r < rays; ++r) {
+    const Vec3 direction = Vec3(normal(random), normal(random), normal(random)).normalized();
+    votes += impl_->crossings(p, direction, true) > 0;
+  }
+  return 2 * votes > rays;
 }
 
 }  // namespace mesh

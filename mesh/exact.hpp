@@ -20,6 +20,12 @@ class ExactSurface {
   // directions), complemented for an inside-out mesh (negative signed volume: a container).
   // Meaningful for closed meshes.
   bool inside(const Vec3& p) const;
+  // Inside by the majority of `rays` rays in random directions (fixed seed), each counting the
+  // faces it leaves through minus those it enters through: the winding number along the ray.
+  // For a file that is no closed surface (overlapping shells count once where parity would
+  // cancel them; a ray through a hole is outvoted): the independent check of the winding-number
+  // solid repair takes from such a file.
+  bool inside_by_ray_majority(const Vec3& p, int rays) const;
   double signed_distance(const Vec3& p) const { return inside(p) ? -distance(p) : distance(p); }
 
  private:

@@ -126,24 +126,34 @@ ImportResult import_mesh(const fs::path& path, const ImportOptions& options) {
     throw InputError(path.string(), "triangles", "the file holds no triangles",
                      "Export the solid as a surface mesh");
 
-  const double scale = metres_per_unit(options.unit);
-  for (Vec3& v : result.mesh.vertices) {
+  for (const Vec3& v : result.mesh.vertices)
     if (!v.allFinite())
       throw InputError(path.string(), "vertices",
                        "a vertex coordinate is not a finite number (NaN or infinity)",
                        "Repair or export the mesh again");
-    v *= scale;
-  }
+  result.unit_guessed = !options.unit;
+  const double extent_in_file = bounding_box(result.mesh).size().maxCoeff();
+  result.unit = options.unit ? *options.unit : guess_unit(extent_in_file);
+  const double scale = metres_per_unit(result.unit);
+  for (Vec3& v : result.mesh.vertices) v *= scale;
   result.vertices_welded = weld_exact(result.mesh);
+  if (result.unit_guessed && result.unit != LengthUnit::mm) {
+    std::string msg = fmt::format(
+        "{}: no unit given; the mesh is {:.4g} across in the file's numbers, read as {} ({:.4g} mm across: "
+        "README, \"Units\"). Declare the unit (--units, or die.units in the scene) if that is wrong",
+        path.string(), extent_in_file, unit_name(result.unit), extent_in_file * scale * 1e3);
+    diefill::log::write_warning(msg);
+    result.warnings.push_back(msg);
+  }
 
   // A die or a grain is between a few tenths of a millimetre and a metre across; outside that
   // range the declared unit is probably wrong.
-  const double extent = bounding_box(result.mesh).size().maxCoeff();
+  const double extent = extent_in_file * scale;
   if (extent < 2e-4 || extent > 2.0) {
     std::string msg = fmt::format(
         "{}: the mesh is {:.4g} {} across ({:.4g} m), implausible for a die or grain; "
         "is `units` right (mm, m or in)?",
-        path.string(), extent / scale, unit_name(options.unit), extent);
+        path.string(), extent / scale, unit_name(result.unit), extent);
     diefill::log::write_warning(msg);
     result.warnings.push_back(msg);
   }

@@ -2,6 +2,7 @@
 // Reading a user's CAD mesh through assimp: every format assimp reads, several meshes in one
 // file joined into one, duplicate vertices welded, coordinates converted to metres.
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -10,11 +11,13 @@
 namespace mesh {
 
 struct ImportOptions {
-  LengthUnit unit = LengthUnit::mm;
+  std::optional<LengthUnit> unit = LengthUnit::mm;  // unset: guessed from the size (guess_unit), with a warning
 };
 
 struct ImportResult {
   TriMesh mesh;                        // metres
+  LengthUnit unit = LengthUnit::mm;    // the file's unit, as given or guessed
+  bool unit_guessed = false;
   std::string format;                  // file extension as assimp saw it
   int meshes_joined = 0;               // meshes (solids, objects) found in the file
   std::size_t vertices_read = 0;       // before welding

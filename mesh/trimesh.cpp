@@ -69,6 +69,22 @@ LengthUnit parse_unit(std::string_view text, std::string_view field) {
                             "Use mm, m or in");
 }
 
+std::optional<LengthUnit> parse_unit_or_auto(std::string_view text, std::string_view field) {
+  if (text == "auto") return std::nullopt;
+  try {
+    return parse_unit(text, field);
+  } catch (const diefill::InputError&) {
+    throw diefill::InputError("", std::string(field), "unknown length unit '" + std::string(text) + "'",
+                              "Use mm, m, in, or auto (guessed from the mesh's size)");
+  }
+}
+
+LengthUnit guess_unit(double extent_in_file_units) {
+  if (extent_in_file_units >= 3.0) return LengthUnit::mm;
+  if (extent_in_file_units >= 1.0) return LengthUnit::in;
+  return LengthUnit::m;
+}
+
 }  // namespace mesh
 
 namespace mesh {

@@ -84,6 +84,8 @@ nlohmann::json report_json(const FillRecord& r, const nlohmann::json& fill, cons
        {{"name", die.name},
         {"source", die.source},
         {"sha256", die.sha256},
+        {"units", mesh::unit_name(die.unit)},
+        {"units_guessed", die.unit_guessed},
         {"up_in_file", mesh::up_name(die.up)},
         {"up_found", die.up_found},
         {"cavity_volume_m3", die.after.volume_m3},

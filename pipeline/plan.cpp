@@ -33,7 +33,7 @@ DieSource read_die(const PipelineScene& scene, const std::filesystem::path& die_
   if (mesh::parse_role(scene.die_role, "die.role") != mesh::WallRole::cavity)
     throw diefill::InputError(die_mesh.string(), "die.role", "the pipeline fills a cavity", "Give the cavity mesh (role \"cavity\")");
   DieSource die;
-  die.file = mesh::read_die_file(die_mesh, mesh::parse_unit(scene.die_units, "die.units"), mesh::parse_up(scene.die_up, "die.up"));
+  die.file = mesh::read_die_file(die_mesh, mesh::parse_unit_or_auto(scene.die_units, "die.units"), mesh::parse_up(scene.die_up, "die.up"));
   if (die.file.up_found && die.file.up != mesh::Up{})
     diefill::log::warn("{}: its opening (a flat face at its extreme) faces {} in the file; turned so that it faces up. "
                        "Set die.up to choose another way",

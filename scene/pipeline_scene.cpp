@@ -52,7 +52,9 @@ KeyTable<P> make_pipeline_keys() {
   const Shapes die = Shapes::die, settling = Shapes::settling, run = Shapes::run, nothing = Shapes::nothing;
   KeyTable<P> k = {
       text("die", "file", KeyType::path, {}, die, "the die's cavity mesh (relative to the scene file)", &P::die),
-      text("die", "units", KeyType::choice, {"mm", "m", "in"}, die, "the mesh file's length unit (files store none)",
+      text("die", "units", KeyType::choice, {"auto", "mm", "m", "in"}, die,
+           "the mesh file's length unit (files store none); auto: guessed from its size, 3 or more across mm, 1 to 3 "
+           "inches, under 1 metres (a warning says so unless mm)",
            &P::die_units),
       text("die", "up", KeyType::choice, {"auto", "+z", "-z", "+x", "-x", "+y", "-y"}, die,
            "the way the cavity's opening faces in the file; the die is turned so that it faces up (+z). auto: +z "

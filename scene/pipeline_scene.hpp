@@ -18,7 +18,7 @@ struct PipelineScene {
   std::string source = "(defaults)";  // the scene file, or the defaults
   // [die]
   std::filesystem::path die;  // mesh
-  std::string die_units = "mm";
+  std::string die_units = "auto";
   std::string die_role = "cavity";
   std::string die_up = "auto";
   double die_voxel_fraction = 0.25;  // SDF voxel edge [largest grain radii] (mesh::default_voxel_fraction)

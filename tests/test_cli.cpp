@@ -68,7 +68,12 @@ TEST(Cli, SdfRejectsBadMeshesClearly) {
   test::write_text(dir / "nested.stl", test::ascii_stl(test::joined(test::box_mm(0, 10), test::box_mm(2, 8))));
   expect_bad_input("sdf --role tool " + d + "/nested.stl", "nested.stl", "inside another shell");
   mesh::write_stl(ring, dir / "ring_in_metres.stl", mesh::LengthUnit::m, "ring, m");
-  expect_bad_input("sdf " + d + "/ring_in_metres.stl", "ring_in_metres.stl", "--units m");
+  // Declared millimetres, a ring stored in metres is too small for the voxel (undeclared, its
+  // size says metres: README, "Units").
+  expect_bad_input("sdf --units mm " + d + "/ring_in_metres.stl", "ring_in_metres.stl", "--units m");
+  const test::Run guessed = test::run_diefill("sdf --voxel 0.5 " + d + "/ring_in_metres.stl");
+  EXPECT_EQ(guessed.status, 0) << guessed.output;
+  EXPECT_NE(guessed.output.find("read as m (20 mm across"), std::string::npos) << guessed.output;
   expect_bad_input("sdf --units furlong " + d + "/ring.stl", "--units", "unknown length unit");
   expect_bad_input("run --units furlong " + d + "/ring.stl", "die.units", "unknown length unit");
   expect_bad_input("sdf --up sideways " + d + "/ring.stl", "--up", "not a direction");

@@ -202,6 +202,31 @@ TEST(Import, AppliesDeclaredUnitAndWarnsWhenImplausible) {
   EXPECT_NE(metres.warnings[0].find("units"), std::string::npos);
 }
 
+// No unit given: the file's numbers say it (README, "Units"). A box 10 across is millimetres and
+// read silently; 2 across, inches; 0.1 across, metres; each guess other than mm is a warning.
+TEST(Import, GuessesAnUndeclaredUnitFromTheSize) {
+  test::TempDir dir;
+  const struct {
+    double side;
+    mesh::LengthUnit unit;
+  } cases[] = {{10, mesh::LengthUnit::mm}, {3, mesh::LengthUnit::mm}, {2.9, mesh::LengthUnit::in},
+               {1, mesh::LengthUnit::in}, {0.99, mesh::LengthUnit::m}, {0.1, mesh::LengthUnit::m}};
+  for (const auto& c : cases) {
+    // Written in metres, so that the file's numbers are the side as given.
+    mesh::write_stl(test::box_mm(0, 1e3 * c.side), dir / "box.stl", mesh::LengthUnit::m, "box");
+    const mesh::ImportResult r = mesh::import_mesh(dir / "box.stl", {std::nullopt});
+    EXPECT_EQ(r.unit, c.unit) << c.side;
+    EXPECT_TRUE(r.unit_guessed);
+    // STL stores single-precision coordinates: equal to a part in 10⁷.
+    const double side = c.side * mesh::metres_per_unit(c.unit);
+    EXPECT_NEAR(mesh::bounding_box(r.mesh).size().x(), side, 1e-7 * side) << c.side;
+    EXPECT_EQ(r.warnings.size(), c.unit == mesh::LengthUnit::mm ? 0u : 1u) << c.side;
+    const mesh::ImportResult declared = mesh::import_mesh(dir / "box.stl", {mesh::LengthUnit::mm});
+    EXPECT_FALSE(declared.unit_guessed);
+    EXPECT_EQ(declared.unit, mesh::LengthUnit::mm) << "a declared unit is never second-guessed";
+  }
+}
+
 TEST(Import, RejectsFilesThatHoldNoMesh) {
   test::TempDir dir;
   auto expect_error = [&](const std::filesystem::path& path, const std::string& words) {
