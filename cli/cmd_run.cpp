@@ -104,7 +104,7 @@ int run_pipeline(const RunCommand& c) {
       return diefill::exit_interrupted;
     }
     if (root) fmt::print("{}: report {}\n", run.die, (run.dir / "report.json").string());
-    return 0;
+    return stop_requested() ? diefill::exit_interrupted : 0;
   }
   // A folder: every mesh into its own folder, then a summary table.
   PipelineScene scene = scene_for({}, c.overrides);
@@ -122,7 +122,8 @@ int run_pipeline(const RunCommand& c) {
   for (const fs::path& mesh : meshes_in(c.target)) {
     try {
       const DieRun run = run_die_fill(scene, mesh, c.resume, ranks);
-      if (run.interrupted) return diefill::exit_interrupted;
+      // Stopped while its outputs were written (the FEM hand-off): that die is done, no other starts.
+      if (run.interrupted || stop_requested()) return diefill::exit_interrupted;
       if (!root) continue;
       const auto& fill = run.report["fill"];
       const auto value = [&](const char* key) { return fill.value(key, 0.0); };

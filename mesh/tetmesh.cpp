@@ -13,6 +13,9 @@
 
 #include <map>
 
+#include <fmt/core.h>
+
+#include "core/child_process.hpp"
 #include "core/error.hpp"
 
 namespace mesh {
@@ -60,12 +63,7 @@ bool is_flat_boundary_cell(const C3t3& c3t3, const Cell& c) {
   return boundary_faces >= 2;
 }
 
-}  // namespace
-
-TetMesh tetrahedralise(const TriMesh& surface, const TetMeshOptions& o, const std::string& source) {
-  if (!(o.element_size_m > 0) || !(o.facet_distance_m > 0))
-    throw diefill::InputError(source, "fem.element_size", "element size and facet distance must be positive",
-                              "Give a positive element size");
+TetMesh tetrahedralise_here(const TriMesh& surface, const TetMeshOptions& o) {
   SurfaceMesh sm = surface_mesh(surface);
   CGAL::Random seeded(0);  // the domain's own sampling; make_mesh_3 reseeds CGAL's default generator
   Domain domain(sm, &seeded);
@@ -102,6 +100,33 @@ TetMesh tetrahedralise(const TriMesh& surface, const TetMeshOptions& o, const st
   }
   for (auto e = c3t3.edges_in_complex_begin(); e != c3t3.edges_in_complex_end(); ++e)
     out.feature_edges.push_back({node(e->first->vertex(e->second)), node(e->first->vertex(e->third))});
+  return out;
+}
+
+}  // namespace
+
+// In a child process (core/child_process.hpp): a large part can take Mesh_3 many minutes, and
+// the user must hear from it and be able to stop it without losing the fill.
+TetMesh tetrahedralise(const TriMesh& surface, const TetMeshOptions& o, const std::string& source) {
+  if (!(o.element_size_m > 0) || !(o.facet_distance_m > 0))
+    throw diefill::InputError(source, "fem.element_size", "element size and facet distance must be positive",
+                              "Give a positive element size");
+  const diefill::ChildResult child = diefill::run_in_child(
+      [&] {
+        const TetMesh m = tetrahedralise_here(surface, o);
+        return diefill::ByteWriter().put(m.nodes).put(m.tets).put(m.feature_edges).put(m.dropped_boundary_slivers).take();
+      },
+      o.wait);
+  if (child.outcome == diefill::ChildOutcome::stopped) throw TetMeshingStopped();
+  TetMesh out;
+  diefill::ByteReader in(child.bytes);
+  in.get(out.nodes);
+  in.get(out.tets);
+  in.get(out.feature_edges);
+  in.get(out.dropped_boundary_slivers);
+  if (child.outcome != diefill::ChildOutcome::done || !in.ok())
+    throw diefill::InputError(source, "surface", fmt::format("CGAL's tetrahedral mesher failed on it (status {})", child.status),
+                              "Check that the die is a closed solid; or set fem.elements = \"none\"");
   if (out.tets.empty())
     throw diefill::InputError(source, "surface", "CGAL's mesher made no tetrahedron inside it",
                               "Check that the die is a closed solid larger than the element size");

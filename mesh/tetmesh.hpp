@@ -3,9 +3,11 @@
 // alone: its headers are the heaviest of the project). Sharp edges of the surface are protected,
 // so that they lie on mesh edges; docs/INTERFACE.md ("FEM hand-off") says how it is used.
 #include <array>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "core/child_process.hpp"
 #include "mesh/trimesh.hpp"
 
 namespace mesh {
@@ -16,6 +18,12 @@ struct TetMeshOptions {
   double element_size_m = 1e-3;     // the largest edge of tetrahedra and boundary facets [m]
   double facet_distance_m = 2e-5;   // how far a boundary facet may lie from the surface [m]
   double feature_angle_deg = 60.0;  // surface edges sharper than this are protected
+  diefill::ChildWait wait;          // progress and stop while the mesher runs (its own process)
+};
+
+// The wait's stop was asked for: no mesh.
+struct TetMeshingStopped : std::runtime_error {
+  TetMeshingStopped() : std::runtime_error("tetrahedral meshing stopped") {}
 };
 
 struct TetMesh {
@@ -29,8 +37,9 @@ struct TetMesh {
   std::size_t dropped_boundary_slivers = 0;
 };
 
-// Meshes the solid bounded by `surface` (closed, outward). Deterministic: the same surface and
-// options give the same mesh. Throws InputError naming `source` when CGAL cannot mesh it.
+// Meshes the solid bounded by `surface` (closed, outward), in a child process. Deterministic: the
+// same surface and options give the same mesh. Throws InputError naming `source` when CGAL
+// cannot mesh it, TetMeshingStopped when `options.wait.stop` asks.
 TetMesh tetrahedralise(const TriMesh& surface, const TetMeshOptions& options, const std::string& source);
 
 struct TetQuality {

@@ -9,11 +9,9 @@
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <cstdint>
 
+#include "core/child_process.hpp"
 #include "core/log.hpp"
 #include "mesh/cgal_ops.hpp"
 
@@ -121,70 +119,38 @@ bool union_in_this_process(const TriMesh& closed_shells, UnionResult& out) {
   return true;
 }
 
-bool write_all(int fd, const void* data, std::size_t bytes) {
-  const char* p = static_cast<const char*>(data);
-  while (bytes > 0) {
-    const ssize_t n = ::write(fd, p, bytes);
-    if (n <= 0) return false;
-    p += n, bytes -= std::size_t(n);
-  }
-  return true;
-}
-
-bool read_all(int fd, void* data, std::size_t bytes) {
-  char* p = static_cast<char*>(data);
-  while (bytes > 0) {
-    const ssize_t n = ::read(fd, p, bytes);
-    if (n <= 0) return false;
-    p += n, bytes -= std::size_t(n);
-  }
-  return true;
-}
-
 }  // namespace
 
 // Corefinement runs in a child process: CGAL checks its preconditions only in debug builds, and
 // some meshes that pass every check we can make still crash it (3DSMaxExport.stl of the shared
 // broken meshes). A crash there must cost the union, not the user's run.
 bool union_of_shells(const TriMesh& closed_shells, UnionResult& out) {
-  int fds[2];
-  if (::pipe(fds) != 0) return union_in_this_process(closed_shells, out);
-  const pid_t child = ::fork();
-  if (child < 0) {
-    ::close(fds[0]), ::close(fds[1]);
-    return union_in_this_process(closed_shells, out);
-  }
-  if (child == 0) {
-    ::close(fds[0]);
+  const diefill::ChildResult child = diefill::run_in_child([&] {
     UnionResult united;
     const std::uint64_t ok = union_in_this_process(closed_shells, united) ? 1 : 0;
-    const std::uint64_t sizes[5] = {ok, united.mesh.vertices.size(), united.mesh.triangles.size(),
-                                    united.empty_shells, united.unfolded_shells};
-    const bool sent = write_all(fds[1], sizes, sizeof sizes) && write_all(fds[1], &united.moved_m, sizeof united.moved_m) &&
-                      write_all(fds[1], united.mesh.vertices.data(), united.mesh.vertices.size() * sizeof(Vec3)) &&
-                      write_all(fds[1], united.mesh.triangles.data(), united.mesh.triangles.size() * sizeof(Triangle));
-    ::_exit(sent ? 0 : 1);
-  }
-  ::close(fds[1]);
-  std::uint64_t sizes[5] = {0, 0, 0, 0, 0};
-  UnionResult united;
-  bool received = read_all(fds[0], sizes, sizeof sizes) && read_all(fds[0], &united.moved_m, sizeof united.moved_m);
-  if (received && sizes[0] == 1) {
-    united.mesh.vertices.resize(sizes[1]);
-    united.mesh.triangles.resize(sizes[2]);
-    united.empty_shells = sizes[3];
-    united.unfolded_shells = sizes[4];
-    received = read_all(fds[0], united.mesh.vertices.data(), united.mesh.vertices.size() * sizeof(Vec3)) &&
-               read_all(fds[0], united.mesh.triangles.data(), united.mesh.triangles.size() * sizeof(Triangle));
-  }
-  ::close(fds[0]);
-  int status = 0;
-  ::waitpid(child, &status, 0);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    diefill::log::debug("union: corefinement ended abnormally (status {})", status);
+    return diefill::ByteWriter()
+        .put(ok)
+        .put(united.empty_shells)
+        .put(united.unfolded_shells)
+        .put(united.moved_m)
+        .put(united.mesh.vertices)
+        .put(united.mesh.triangles)
+        .take();
+  });
+  if (child.outcome != diefill::ChildOutcome::done) {
+    diefill::log::debug("union: corefinement ended abnormally (status {})", child.status);
     return false;
   }
-  if (!received || sizes[0] != 1) return false;
+  diefill::ByteReader in(child.bytes);
+  std::uint64_t ok = 0;
+  UnionResult united;
+  in.get(ok);
+  in.get(united.empty_shells);
+  in.get(united.unfolded_shells);
+  in.get(united.moved_m);
+  in.get(united.mesh.vertices);
+  in.get(united.mesh.triangles);
+  if (!in.ok() || ok != 1) return false;
   out = std::move(united);
   return true;
 }

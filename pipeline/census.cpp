@@ -93,6 +93,12 @@ void check_losses(const Census& c, const std::string& die_source, const std::str
     diefill::log::warn("{}: {} grains spilled over the die table's edge beside the shoe; counted in report.json "
                        "(particles.lost), not in the fill",
                        die_name, c.lost);
+  // A shoe that ends (nearly) empty may have run out before the cavity was full: a die larger
+  // than the shoe's powder (the shared 304 mm flange disc under a 3000-grain shoe) is no fill.
+  if (c.in_shoe * 20 < c.grains)
+    diefill::log::warn("{}: the shoe ran out of powder ({} of its {} grains left in it, {} in the cavity): the cavity may "
+                       "not be full. Give the shoe more powder (shoe.fill_height, shoe.length, powder.max_grains)",
+                       die_name, c.in_shoe, c.grains, c.in_cavity);
 }
 
 }  // namespace app

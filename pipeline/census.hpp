@@ -24,7 +24,7 @@ double member_weight(const dem::State& state, std::size_t body);
 
 Census count_grains(const dem::State& state, double table_z, const ShoePlan& shoe);
 // InputError naming the die when a grain left through it; a warning for grains spilled beside the
-// shoe (counted in the report, not in the fill).
+// shoe (counted in the report, not in the fill) and for a shoe that ran out of powder.
 void check_losses(const Census& census, const std::string& die_source, const std::string& die_name);
 
 }  // namespace app

@@ -10,6 +10,7 @@
 #include "dem/step.hpp"
 #include "pipeline/density_stage.hpp"
 #include "pipeline/fem_stage.hpp"
+#include "mesh/tetmesh.hpp"
 #include "pipeline/fill_curve.hpp"
 #include "pipeline/pictures.hpp"
 #include "scene/physics_keys.hpp"
@@ -47,7 +48,13 @@ nlohmann::json write_fem_section(const FillRecord& r, const nlohmann::json& fill
   settings.quadratic = r.scene.fem_elements == "quadratic";
   settings.compaction = r.scene.fem_compaction == "calculix";
   const double density = r.walls.spec.materials[std::size_t(r.walls.powder)].density;
-  return write_fem_outputs(r.census.cavity, r.walls.die, *r.walls.die_field, density, fill.at("mass_kg"), settings, dir);
+  try {
+    return write_fem_outputs(r.census.cavity, r.walls.die, *r.walls.die_field, density, fill.at("mass_kg"), settings, dir);
+  } catch (const mesh::TetMeshingStopped&) {
+    diefill::log::warn("{}: the FEM hand-off was stopped while its tetrahedra were meshed: no fem/; the fill's outputs are "
+                       "written", r.walls.die.name);
+    return nullptr;
+  }
 }
 
 // The fill curve (CSV and chart; it ends at the field's mass, fill.mass_kg) and what the report

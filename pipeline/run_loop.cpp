@@ -36,6 +36,8 @@ void install_interrupt_handler() {
   for (int signal : stop_signals) std::signal(signal, on_interrupt);
 }
 
+bool stop_requested() { return g_interrupted; }
+
 LoopResult run_until(const dem::Model& model, dem::State& s, const LoopOptions& o) {
   LoopResult result;
   diefill::Stopwatch clock;

@@ -48,6 +48,8 @@ struct LoopResult {
 
 // Installs the handler of Ctrl-C, SIGTERM and SIGUSR1 (once); a second signal kills the process as usual.
 void install_interrupt_handler();
+// Whether one of them arrived: the stages after the DEM loop stop their long steps on it.
+bool stop_requested();
 
 LoopResult run_until(const dem::Model& model, dem::State& state, const LoopOptions& options);
 

@@ -1,9 +1,14 @@
 // core: hashing and atomic output.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <cstdlib>
 #include <cstring>
 
 #include "core/atomic_file.hpp"
+#include "core/child_process.hpp"
+#include "core/timer.hpp"
 #include "core/base64.hpp"
 #include "core/error.hpp"
 #include "core/sha256.hpp"
@@ -76,4 +81,41 @@ TEST(StagingFolder, ReplacesAnEarlierRunsFilesAndSubfolderWhole) {
 TEST(InputError, NamesFileFieldAndRemedy) {
   const diefill::InputError e("scene.toml", "simulation.duration", "must be positive", "Give a duration in seconds");
   EXPECT_STREQ(e.what(), "scene.toml: simulation.duration: must be positive. Give a duration in seconds");
+}
+
+// Work in a child process (core/child_process.hpp): its bytes come back whole, a crash or a throw
+// there is a failed outcome in this process, and a stop ends a child that would run a minute
+// within the poll's second.
+TEST(ChildProcess, ReturnsTheBytesReportsACrashAndStopsOnRequest) {
+  const std::vector<double> values = {1.5, -2.25, 1e300};
+  const diefill::ChildResult done =
+      diefill::run_in_child([&] { return diefill::ByteWriter().put(std::uint64_t(7)).put(values).take(); });
+  ASSERT_EQ(done.outcome, diefill::ChildOutcome::done);
+  diefill::ByteReader in(done.bytes);
+  std::uint64_t seven = 0;
+  std::vector<double> back;
+  in.get(seven);
+  in.get(back);
+  EXPECT_TRUE(in.ok());
+  EXPECT_EQ(seven, 7u);
+  EXPECT_EQ(back, values);
+  std::uint64_t past_the_end = 0;
+  in.get(past_the_end);
+  EXPECT_FALSE(in.ok());
+
+  EXPECT_EQ(diefill::run_in_child([]() -> std::string { throw std::runtime_error("no"); }).outcome,
+            diefill::ChildOutcome::failed);
+  EXPECT_EQ(diefill::run_in_child([]() -> std::string { std::_Exit(9); }).outcome, diefill::ChildOutcome::failed);
+
+  int polls = 0;
+  diefill::Stopwatch clock;
+  const diefill::ChildResult stopped = diefill::run_in_child(
+      [] {
+        ::sleep(60);
+        return std::string("late");
+      },
+      {[&] { return ++polls >= 2; }, nullptr});
+  EXPECT_EQ(stopped.outcome, diefill::ChildOutcome::stopped);
+  EXPECT_TRUE(stopped.bytes.empty());
+  EXPECT_LT(clock.seconds(), 10.0);
 }
