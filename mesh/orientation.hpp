@@ -23,9 +23,13 @@ std::string up_name(Up up);
 // Area of the faces lying flat at the mesh's extreme along `up` and facing it [m²].
 double opening_area(const TriMesh& mesh, Up up);
 
-// +z whenever a flat face lies at the top (every die made for diefill), else the axis whose
-// extreme holds the largest flat face facing out (of two alike, the + one). Throws InputError naming `source` when no axis
-// has one.
+// Area of the mesh's shadow along `axis`: the part's outline seen along it [m²].
+double shadow_area(const TriMesh& mesh, int axis);
+
+// The opening a shoe can pass over: +z when the flat faces at the top cover at least half of the
+// part's shadow along z (every die made for diefill), else the extreme whose flat faces cover the
+// largest share of the shadow along their axis (of two alike, the + one). Throws InputError
+// naming `source` when no axis has one.
 Up find_opening(const TriMesh& mesh, const std::string& source);
 
 // Turns the mesh so that `up` becomes +z (a proper rotation; +z leaves it as it is).

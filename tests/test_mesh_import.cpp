@@ -105,6 +105,9 @@ TEST(Orientation, FindsTheOpeningWhicheverWayTheDieFaces) {
       for (int k = 0; k < 3; ++k) mesh::turn_up(extruded, up);
       EXPECT_EQ(mesh::find_opening(extruded, "ring"), (mesh::Up{axis, 1}));
     }
+  // Every generated die (the 1.2 mm slot's opening is its whole outline, its sides 6.7 times its area).
+  for (const std::string& name : mesh::generated_die_names())
+    EXPECT_EQ(mesh::find_opening(mesh::bundled_die(name), name), mesh::Up{}) << name;
   mesh::TriMesh octahedron;
   for (int a = 0; a < 3; ++a)
     for (int s : {1, -1}) octahedron.vertices.push_back(s * Vec3::Unit(a) * 1e-2);
@@ -118,6 +121,18 @@ TEST(Orientation, FindsTheOpeningWhicheverWayTheDieFaces) {
   EXPECT_EQ(mesh::parse_up("auto", "die.up"), std::nullopt);
   EXPECT_EQ(mesh::parse_up("-y", "die.up"), (mesh::Up{1, -1}));
   EXPECT_THROW(mesh::parse_up("up", "die.up"), diefill::InputError);
+}
+
+// A flat top that covers a small part of the outline is no opening: a flange plate (Ø20 mm, 2 mm)
+// under a boss (Ø4 mm, 3 mm high: its top is 4 % of the shadow along z) is filled through the
+// plate's face, below; the shadow along z is the plate's disc.
+TEST(Orientation, ABossIsNoOpening) {
+  mesh::TriMesh flange = mesh::ring_cavity(20e-3, 0, 2e-3, 1e-6);
+  mesh::TriMesh boss = mesh::ring_cavity(4e-3, 0, 3e-3, 1e-6);
+  for (Vec3& v : boss.vertices) v.z() += 3e-3;
+  const mesh::TriMesh part = test::joined(flange, boss);
+  EXPECT_NEAR(mesh::shadow_area(part, 2), std::numbers::pi * 1e-4, 0.01 * std::numbers::pi * 1e-4);
+  EXPECT_EQ(mesh::find_opening(part, "flange"), (mesh::Up{2, -1}));
 }
 
 // Read from a file with its opening facing -x, the die is the same cavity as the one facing up:

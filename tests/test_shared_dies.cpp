@@ -141,6 +141,18 @@ TEST(SharedDieUnits, AreGuessedAsTheSourcesJudgeThem) {
   }
 }
 
+// The opening a shoe can pass over, on two shared dies whose top face is a tooth tip (the open
+// 8-tooth gear, lying on its side) and a boss (the flanged ring): the gear's side with the larger
+// flat face (-y: 235 mm² against 181) and the flange plate's face (-z).
+TEST(SharedDieOpenings, AreTheFacesThatOpenTheOutline) {
+  REQUIRE_SHARED_MESHES();
+  const auto opening = [](const char* file, mesh::LengthUnit unit) {
+    return mesh::read_die_file(test::shared_meshes() / "dies" / file, unit, std::nullopt).up;
+  };
+  EXPECT_EQ(mesh::up_name(opening("gear_8tooth_open_thingi10k_50736.stl", mesh::LengthUnit::mm)), "-y");
+  EXPECT_EQ(mesh::up_name(opening("flanged_ring_trimesh_idler_riser.stl", mesh::LengthUnit::in)), "-z");
+}
+
 // Where the cell's candidate triangles miss the closest one: on the flange disc, 0.53 mm inside
 // the solid at 1.01 mm voxels, the descents from the cell's eight candidates end on faces of
 // both signs and the nearest of them (+0.531 mm) was the wrong one. Candidates that disagree in
