@@ -58,7 +58,8 @@ KeyTable<P> make_pipeline_keys() {
            &P::die_units),
       text("die", "up", KeyType::choice, {"auto", "+z", "-z", "+x", "-x", "+y", "-y"}, die,
            "the way the cavity's opening faces in the file; the die is turned so that it faces up (+z). auto: +z "
-           "when a flat face lies at the top, else the axis with the largest flat face at its extreme",
+           "when the flat faces at the top cover half of the part's outline seen from above, else the extreme whose "
+           "flat faces cover the largest share of the outline along their axis",
            &P::die_up),
       text("die", "role", KeyType::choice, {"cavity"}, die,
            "the mesh is the part's shape, open at the die table (its highest z); `diefill sdf --role` takes tools too",
