@@ -107,7 +107,8 @@ TetMesh tetrahedralise_here(const TriMesh& surface, const TetMeshOptions& o) {
 
 // In a child process (core/child_process.hpp): a large part can take Mesh_3 many minutes, and
 // the user must hear from it and be able to stop it without losing the fill.
-TetMesh tetrahedralise(const TriMesh& surface, const TetMeshOptions& o, const std::string& source) {
+TetMesh tetrahedralise(const TriMesh& surface, const TetMeshOptions& o, const std::string& source,
+                       const diefill::ChildWait& wait) {
   if (!(o.element_size_m > 0) || !(o.facet_distance_m > 0))
     throw diefill::InputError(source, "fem.element_size", "element size and facet distance must be positive",
                               "Give a positive element size");
@@ -116,7 +117,7 @@ TetMesh tetrahedralise(const TriMesh& surface, const TetMeshOptions& o, const st
         const TetMesh m = tetrahedralise_here(surface, o);
         return diefill::ByteWriter().put(m.nodes).put(m.tets).put(m.feature_edges).put(m.dropped_boundary_slivers).take();
       },
-      o.wait);
+      wait);
   if (child.outcome == diefill::ChildOutcome::stopped) throw TetMeshingStopped();
   TetMesh out;
   diefill::ByteReader in(child.bytes);

@@ -18,7 +18,6 @@ struct TetMeshOptions {
   double element_size_m = 1e-3;     // the largest edge of tetrahedra and boundary facets [m]
   double facet_distance_m = 2e-5;   // how far a boundary facet may lie from the surface [m]
   double feature_angle_deg = 60.0;  // surface edges sharper than this are protected
-  diefill::ChildWait wait;          // progress and stop while the mesher runs (its own process)
 };
 
 // The wait's stop was asked for: no mesh.
@@ -37,10 +36,11 @@ struct TetMesh {
   std::size_t dropped_boundary_slivers = 0;
 };
 
-// Meshes the solid bounded by `surface` (closed, outward), in a child process. Deterministic: the
-// same surface and options give the same mesh. Throws InputError naming `source` when CGAL
-// cannot mesh it, TetMeshingStopped when `options.wait.stop` asks.
-TetMesh tetrahedralise(const TriMesh& surface, const TetMeshOptions& options, const std::string& source);
+// Meshes the solid bounded by `surface` (closed, outward), in a child process whose progress and
+// stop `wait` gives. Deterministic: the same surface and options give the same mesh. Throws
+// InputError naming `source` when CGAL cannot mesh it, TetMeshingStopped when `wait.stop` asks.
+TetMesh tetrahedralise(const TriMesh& surface, const TetMeshOptions& options, const std::string& source,
+                       const diefill::ChildWait& wait = {});
 
 struct TetQuality {
   std::size_t inverted = 0;        // tetrahedra of zero or negative volume

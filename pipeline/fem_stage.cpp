@@ -57,14 +57,14 @@ FemSettings fem_settings(double grain_diameter, double density_voxel, double ele
 
 nlohmann::json write_fem_outputs(const std::vector<post::Grain>& grains, const mesh::PreparedDie& die, const mesh::WallField& walls,
                                  double material_density, double mass_in_cavity_kg, const FemSettings& s, const fs::path& dir) {
-  mesh::TetMeshOptions meshing{s.element_size_m, s.element_size_m / 200, 60};
-  meshing.wait.stop = stop_requested;
-  meshing.wait.waiting = [&](double seconds) {
+  diefill::ChildWait wait;
+  wait.stop = stop_requested;
+  wait.waiting = [&](double seconds) {
     diefill::log::info("{}: FEM hand-off: meshing the cavity in tetrahedra of {:.3g} mm, {:.0f} s so far (Ctrl-C skips "
                        "the hand-off and keeps the fill; fem.element_size coarsens it)",
                        die.name, s.element_size_m * 1e3, seconds);
   };
-  mesh::TetMesh tets = mesh::tetrahedralise(die.cavity, meshing, die.source);
+  mesh::TetMesh tets = mesh::tetrahedralise(die.cavity, {s.element_size_m, s.element_size_m / 200, 60}, die.source, wait);
   const mesh::TetQuality q = mesh::tet_quality(tets);
   const post::CavityShape cavity{[&](const post::Vec3& p) { return walls.signed_distance(p); }, die.after.bbox.lo,
                                  post::Vec3(die.after.bbox.hi.x(), die.after.bbox.hi.y(), die.table_z)};
