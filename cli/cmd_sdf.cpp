@@ -28,7 +28,7 @@ int run_sdf(const SdfCommand& c) {
              file.unit_guessed ? ", guessed from its size; --units chooses" : "", die.sha256);
   if (die.up != mesh::Up{})
     fmt::print("orientation: the opening faces {} in the file ({}); turned so that it faces +z\n", mesh::up_name(die.up),
-               die.up_found ? "found: its largest flat face at an extreme; --up chooses" : "--up");
+               die.up_found ? "found: the flat extreme face that opens the most of its outline; --up chooses" : "--up");
   fmt::print("check:\n{}", mesh::format_report(die.before));
   if (die.actions.empty()) {
     fmt::print("repair: nothing to do\n");

@@ -1,6 +1,8 @@
 #include "mesh/orientation.hpp"
 
 #include <algorithm>
+#include <array>
+#include <optional>
 #include <cmath>
 #include <vector>
 
@@ -73,10 +75,13 @@ double shadow_area(const TriMesh& mesh, int axis) {
 }
 
 Up find_opening(const TriMesh& mesh, const std::string& source) {
-  // How much of the part's outline along the axis a shoe passing over that face reaches.
+  // How much of the part's outline along the axis a shoe passing over that face reaches; each
+  // axis's shadow rasterised once (both of its ends share it), and only where a face asks.
+  std::array<std::optional<double>, 3> shadows;
   const auto open_share = [&](Up up, double area) {
-    const double shadow = shadow_area(mesh, up.axis);
-    return shadow > 0 ? area / shadow : 0.0;
+    std::optional<double>& shadow = shadows[std::size_t(up.axis)];
+    if (!shadow) shadow = shadow_area(mesh, up.axis);
+    return *shadow > 0 ? area / *shadow : 0.0;
   };
   if (const double top = opening_area(mesh, Up{}); top > 0 && open_share(Up{}, top) >= min_top_open_share) return Up{};
   // Two ends alike (an extruded part) to rounding: the + one, so that the choice is the same on
