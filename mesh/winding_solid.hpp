@@ -7,7 +7,7 @@
 
 namespace mesh::detail {
 
-// Volumes of a soup's winding number, sampled at the centres of cells (96 along the bounding
+// Volumes of a soup's winding number, sampled at the centres of cells (`cells` along the bounding
 // box's longest side).
 struct WindingSurvey {
   // Volume where the winding number lies between ¼ and ¾ [m³]: neither clearly inside nor
@@ -17,7 +17,7 @@ struct WindingSurvey {
   double solid_volume_m3 = 0.0;  // volume where the winding number is ≥ ½
   long solid_cells = 0;          // cells it was measured on
 };
-WindingSurvey survey_winding(const TriMesh& soup);
+WindingSurvey survey_winding(const TriMesh& soup, int cells = 96);
 
 struct WindingSolid {
   TriMesh mesh;  // closed, outward; empty when the region is empty or could not be closed

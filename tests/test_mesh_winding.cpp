@@ -8,6 +8,7 @@
 #include "mesh/repair.hpp"
 #include "mesh/shapes.hpp"
 #include "mesh/winding.hpp"
+#include "mesh/winding_solid.hpp"
 #include "meshes.hpp"
 
 using mesh::Vec3;
@@ -106,5 +107,46 @@ TEST(Repair, NamesTheRegionWhereTheEnclosedVolumeIsUndefined) {
     EXPECT_NE(what.find("undefined"), std::string::npos) << what;
     // Around the missing top: the region reaches its plane, z = 10 mm.
     EXPECT_NE(what.find("10] mm"), std::string::npos) << what;
+  }
+}
+
+// The survey skips blocks of cells where the winding number is clearly on one side; cell by
+// cell, every cell's centre read exactly, it must count the same: solid cells, ambiguous cells
+// and their box, on an open box (the winding number drifts through ½ around its opening), two
+// overlapping boxes (2 where they overlap) and a box with a post and a missing wall.
+TEST(WindingSurvey, CountsAsEveryCellReadOneByOne) {
+  const mesh::TriMesh die = test::joined(test::box_mm(0, 10), test::reversed(mesh::box_solid(mm(3, 3, 0), mm(7, 7, 4))));
+  mesh::TriMesh missing_wall = die;
+  std::erase_if(missing_wall.triangles, [&](const mesh::Triangle& t) {
+    return missing_wall.vertices[t[0]].x() < 1e-6 && missing_wall.vertices[t[1]].x() < 1e-6 && missing_wall.vertices[t[2]].x() < 1e-6;
+  });
+  for (const mesh::TriMesh& soup : {without_top(test::box_mm(0, 10)), test::joined(test::box_mm(0, 10), test::box_mm(5, 15)), missing_wall}) {
+    // 48 cells along the longest side (the repair's 96 read one by one are slow under the sanitizers).
+    const mesh::detail::WindingSurvey survey = mesh::detail::survey_winding(soup, 48);
+    const mesh::WindingNumber winding(soup);
+    const mesh::Box box = mesh::bounding_box(soup);
+    const double h = box.size().maxCoeff() / 48;
+    const Eigen::Vector3i n = (box.size() / h).array().ceil().cast<int>().max(1);
+    long solid = 0, ambiguous = 0;
+    mesh::Box ambiguous_box;
+    for (int k = 0; k < n.z(); ++k)
+      for (int j = 0; j < n.y(); ++j)
+        for (int i = 0; i < n.x(); ++i) {
+          const Vec3 p = box.lo + h * Vec3(i + 0.5, j + 0.5, k + 0.5);
+          const double w = winding(p);
+          solid += w >= 0.5;
+          if (w > 0.25 && w < 0.75) {
+            ++ambiguous;
+            ambiguous_box.extend(p - Vec3::Constant(0.5 * h));
+            ambiguous_box.extend(p + Vec3::Constant(0.5 * h));
+          }
+        }
+    EXPECT_EQ(survey.solid_cells, solid);
+    EXPECT_NEAR(survey.ambiguous_volume_m3, double(ambiguous) * h * h * h, 1e-9 * double(ambiguous) * h * h * h);
+    if (ambiguous > 0) {
+      EXPECT_LT((survey.ambiguous_box.lo - ambiguous_box.lo).norm(), 1e-6 * h);
+      EXPECT_LT((survey.ambiguous_box.hi - ambiguous_box.hi).norm(), 1e-6 * h);
+    }
+    EXPECT_GT(solid, 0);
   }
 }
