@@ -121,21 +121,9 @@ WindingSolid on_input(TriMesh zero, const TriMesh& soup, const ExactSurface& sur
   // The zero surface cuts corners by up to a cell; its vertices moved onto the closest input
   // point lie on the surface the file means, sharp edges and flat faces included (a flat top
   // face stays exactly flat, which the die's opening needs).
-  // Where the file has no face within a cell (a face missing from it), the zero surface closes
-  // the gap within a cell of where the face was, not on it; at the part's extremes that face was
-  // flat (the flanged ring of the shared dies lacks its flange face, the side the die opens on),
-  // so such vertices within a cell of the input's bounding box go onto the box's face.
-  const Box box = bounding_box(soup);
   tbb::parallel_for(std::size_t(0), zero.vertices.size(), [&](std::size_t v) {
-    Vec3& p = zero.vertices[v];
-    const Vec3 closest = surface.closest_point(p);
-    if ((closest - p).norm() <= cell_m) {
-      p = closest;
-      return;
-    }
-    for (int axis = 0; axis < 3; ++axis)
-      for (const double extreme : {box.lo[axis], box.hi[axis]})
-        if (std::abs(p[axis] - extreme) <= cell_m) p[axis] = extreme;
+    const Vec3 closest = surface.closest_point(zero.vertices[v]);
+    if ((closest - zero.vertices[v]).norm() <= cell_m) zero.vertices[v] = closest;
   });
   // What bounds the region in the input: sample points whose two sides fall on either side
   // of ½ (a quarter cell off the face); faces buried inside or left in the open do not.
