@@ -20,6 +20,13 @@ double max_distance(const TriMesh& from, const TriMesh& to, Samples samples = Sa
 // The same over the sample points (with their face's unit normal) that `counts` accepts.
 using SampleFilter = std::function<bool(const Vec3& point, const Vec3& unit_normal)>;
 double max_distance(const TriMesh& from, const TriMesh& to, const SampleFilter& counts);
+// That distance and the sample point of `from` it was measured at: where a repair moved the
+// surface most, for a message that names the place.
+struct FarthestSample {
+  double distance_m = 0.0;
+  Vec3 point = Vec3::Zero();
+};
+FarthestSample farthest_sample(const TriMesh& from, const TriMesh& to, const SampleFilter& counts);
 
 // Pairs of intersecting triangles that share no vertex; 0 for a clean mesh.
 std::size_t count_self_intersections(const TriMesh& mesh);

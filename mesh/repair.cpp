@@ -239,7 +239,14 @@ std::optional<TriMesh> winding_number_solid(const SurfaceMesh& sm, const MeshRep
                           mm(cell * std::sqrt(solid.refused_terms / max_winding_terms)));
     return std::nullopt;
   }
-  if (solid.mesh.triangles.empty() || solid.moved_m > options.tolerance_m) return std::nullopt;
+  if (solid.mesh.triangles.empty()) return std::nullopt;
+  if (solid.moved_m > options.tolerance_m) {
+    const Vec3 at = 1e3 * solid.moved_most_at;
+    defect += fmt::format("; re-meshed on cells of {} as the solid its winding number encloses, it would move the "
+                          "surface by {} at ({:.4g}, {:.4g}, {:.4g}) mm",
+                          mm(cell), mm(solid.moved_m), at.x(), at.y(), at.z());
+    return std::nullopt;
+  }
   result.actions.push_back(fmt::format(
       "{}: re-meshed as the solid its winding number encloses (cells of {}; ambiguous volume {:.4g} mm³, "
       "{:.3g} % of the solid)",

@@ -129,9 +129,11 @@ WindingSolid on_input(TriMesh zero, const TriMesh& soup, const ExactSurface& sur
   // of ½ (a quarter cell off the face); faces buried inside or left in the open do not.
   const double offset = 0.25 * cell_m;
   WindingSolid out;
-  out.moved_m = max_distance(soup, zero, [&](const Vec3& p, const Vec3& normal) {
+  const FarthestSample moved = farthest_sample(soup, zero, [&](const Vec3& p, const Vec3& normal) {
     return (winding(p + offset * normal) >= 0.5) != (winding(p - offset * normal) >= 0.5);
   });
+  out.moved_m = moved.distance_m;
+  out.moved_most_at = moved.point;
   out.mesh = std::move(zero);
   return out;
 }

@@ -27,6 +27,7 @@ struct WindingSolid {
   // Terms (WindingNumber::terms) signing the distance band would have summed, where that was
   // more than allowed: the mesh is empty then.
   double refused_terms = 0.0;
+  Vec3 moved_most_at = Vec3::Zero();  // the input point `moved_m` was measured at [m]
 };
 
 // The region of `soup` with winding number ≥ ½, meshed on cells of `cell_m` (OpenVDB: the

@@ -36,9 +36,10 @@ std::vector<Triangle3> triangles_of(const TriMesh& mesh) {
 }
 
 // Largest distance from a barycentric grid of sample points on `from` (about 16 along a
-// triangle's longest edge at most) to `tree`, over the points `counts` accepts.
-double max_distance_to(const TriMesh& from, const Tree& tree, const SampleFilter& counts) {
+// triangle's longest edge at most) to `tree`, over the points `counts` accepts, and where.
+FarthestSample farthest_from(const TriMesh& from, const Tree& tree, const SampleFilter& counts) {
   double worst_squared = 0.0;
+  Vec3 worst = Vec3::Zero();
   const double diagonal = bounding_box(from).size().norm();
   for (const Triangle& t : from.triangles) {
     const Vec3& a = from.vertices[t[0]];
@@ -51,10 +52,13 @@ double max_distance_to(const TriMesh& from, const Tree& tree, const SampleFilter
       for (int j = 0; i + j <= k; ++j) {
         const Vec3 v = a + (b - a) * (double(i) / k) + (c - a) * (double(j) / k);
         const double d2 = tree.squared_distance(to_point(v));
-        if (d2 > worst_squared && (!counts || counts(v, normal))) worst_squared = d2;
+        if (d2 > worst_squared && (!counts || counts(v, normal))) {
+          worst_squared = d2;
+          worst = v;
+        }
       }
   }
-  return std::sqrt(worst_squared);
+  return {std::sqrt(worst_squared), worst};
 }
 }  // namespace
 
@@ -86,12 +90,16 @@ TriMesh alpha_wrap(const TriMesh& soup, double alpha, double offset) {
   return out;
 }
 
-double max_distance(const TriMesh& from, const TriMesh& to, const SampleFilter& counts) {
+FarthestSample farthest_sample(const TriMesh& from, const TriMesh& to, const SampleFilter& counts) {
   const std::vector<Triangle3> target = triangles_of(to);
-  if (target.empty() || from.triangles.empty()) return 0.0;
+  if (target.empty() || from.triangles.empty()) return {};
   Tree tree(target.begin(), target.end());
   tree.accelerate_distance_queries();
-  return max_distance_to(from, tree, counts);
+  return farthest_from(from, tree, counts);
+}
+
+double max_distance(const TriMesh& from, const TriMesh& to, const SampleFilter& counts) {
+  return farthest_sample(from, to, counts).distance_m;
 }
 
 double max_distance(const TriMesh& from, const TriMesh& to, Samples samples) {
@@ -99,7 +107,7 @@ double max_distance(const TriMesh& from, const TriMesh& to, Samples samples) {
   if (target.empty() || from.triangles.empty()) return 0.0;
   Tree tree(target.begin(), target.end());
   tree.accelerate_distance_queries();
-  if (samples == Samples::all) return max_distance_to(from, tree, SampleFilter{});
+  if (samples == Samples::all) return farthest_from(from, tree, SampleFilter{}).distance_m;
   // Ray-crossing parity, the majority of three skew rays (one may graze an edge).
   auto outside_target = [&](const Vec3& v, const Vec3&) {
     int votes = 0;
@@ -108,7 +116,7 @@ double max_distance(const TriMesh& from, const TriMesh& to, Samples samples) {
       votes += tree.number_of_intersected_primitives(K::Ray_3(to_point(v), direction)) % 2;
     return votes < 2;
   };
-  return max_distance_to(from, tree, outside_target);
+  return farthest_from(from, tree, outside_target).distance_m;
 }
 
 }  // namespace mesh::detail
