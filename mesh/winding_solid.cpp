@@ -153,8 +153,9 @@ struct SurveyTally {
 
 // The survey's cells, visited as an octree of blocks. The winding number is harmonic away from
 // the surface: in a block no triangle reaches into it varies smoothly, so where it is clearly on
-// one side (within `clear_margin` of 0 or of 1 and beyond) at the block's centre and eight
-// corners, every cell of the block takes that side. The rest is split
+// one side (at most `clear_margin`, or at least 1 - `clear_margin`: an inside-out shell's -1
+// and overlapping shells' 2 included) at the block's centre and eight corners, every cell of
+// the block takes that side. The rest is split
 // down to single cells, each read at its centre: only the cells near the surface, or around an
 // open hole where the winding number drifts, are read one by one (one by one, the 96³ cells
 // were two thirds of a small die's repair under the sanitizers).
@@ -195,8 +196,8 @@ class Survey {
 
   Vec3 corner(const Eigen::Vector3i& cell) const { return box_.lo + cell_m_ * cell.cast<double>(); }
 
-  // The winding number at the block's centre where it and the eight corners' are all within
-  // `clear_margin` of 0 or all beyond 1 - `clear_margin`; nothing otherwise.
+  // The winding number at the block's centre where it and the eight corners' are all at most
+  // `clear_margin` or all at least 1 - `clear_margin`; nothing otherwise.
   std::optional<double> clear_value(const Vec3& lo, const Vec3& hi, const Vec3& centre) const {
     const double w = winding_(centre);
     const bool solid = w >= 0.5;
