@@ -2,6 +2,8 @@
 // Internal to the mesh module: CGAL operations split into their own translation units so that
 // the heavy headers compile in parallel on a 2-core machine.
 #include <functional>
+#include <limits>
+#include <vector>
 
 #include "mesh/trimesh.hpp"
 
@@ -21,12 +23,15 @@ double max_distance(const TriMesh& from, const TriMesh& to, Samples samples = Sa
 using SampleFilter = std::function<bool(const Vec3& point, const Vec3& unit_normal)>;
 double max_distance(const TriMesh& from, const TriMesh& to, const SampleFilter& counts);
 // That distance and the sample point of `from` it was measured at: where a repair moved the
-// surface most, for a message that names the place.
+// surface most, for a message that names the place; with `collect_beyond_m`, also every sample
+// point `counts` accepts that lies farther than it: where a re-mesh should be finer.
 struct FarthestSample {
   double distance_m = 0.0;
   Vec3 point = Vec3::Zero();
+  std::vector<Vec3> beyond;
 };
-FarthestSample farthest_sample(const TriMesh& from, const TriMesh& to, const SampleFilter& counts);
+FarthestSample farthest_sample(const TriMesh& from, const TriMesh& to, const SampleFilter& counts,
+                               double collect_beyond_m = std::numeric_limits<double>::infinity());
 
 // Pairs of intersecting triangles that share no vertex; 0 for a clean mesh.
 std::size_t count_self_intersections(const TriMesh& mesh);

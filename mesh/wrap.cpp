@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include "mesh/cgal_ops.hpp"
@@ -36,8 +37,13 @@ std::vector<Triangle3> triangles_of(const TriMesh& mesh) {
 }
 
 // Largest distance from a barycentric grid of sample points on `from` (about 16 along a
-// triangle's longest edge at most) to `tree`, over the points `counts` accepts, and where.
-FarthestSample farthest_from(const TriMesh& from, const Tree& tree, const SampleFilter& counts) {
+// triangle's longest edge at most) to `tree`, over the points `counts` accepts, where, and the
+// accepted points beyond `collect_beyond_m`. `counts` is asked only of points that would change
+// the answer: on buried faces it would cost two winding numbers a point.
+FarthestSample farthest_from(const TriMesh& from, const Tree& tree, const SampleFilter& counts,
+                             double collect_beyond_m = std::numeric_limits<double>::infinity()) {
+  FarthestSample out;
+  const double collect_squared = collect_beyond_m * collect_beyond_m;
   double worst_squared = 0.0;
   Vec3 worst = Vec3::Zero();
   const double diagonal = bounding_box(from).size().norm();
@@ -52,13 +58,18 @@ FarthestSample farthest_from(const TriMesh& from, const Tree& tree, const Sample
       for (int j = 0; i + j <= k; ++j) {
         const Vec3 v = a + (b - a) * (double(i) / k) + (c - a) * (double(j) / k);
         const double d2 = tree.squared_distance(to_point(v));
-        if (d2 > worst_squared && (!counts || counts(v, normal))) {
+        if (d2 <= worst_squared && d2 <= collect_squared) continue;
+        if (counts && !counts(v, normal)) continue;
+        if (d2 > collect_squared) out.beyond.push_back(v);
+        if (d2 > worst_squared) {
           worst_squared = d2;
           worst = v;
         }
       }
   }
-  return {std::sqrt(worst_squared), worst};
+  out.distance_m = std::sqrt(worst_squared);
+  out.point = worst;
+  return out;
 }
 }  // namespace
 
@@ -90,12 +101,13 @@ TriMesh alpha_wrap(const TriMesh& soup, double alpha, double offset) {
   return out;
 }
 
-FarthestSample farthest_sample(const TriMesh& from, const TriMesh& to, const SampleFilter& counts) {
+FarthestSample farthest_sample(const TriMesh& from, const TriMesh& to, const SampleFilter& counts,
+                               double collect_beyond_m) {
   const std::vector<Triangle3> target = triangles_of(to);
   if (target.empty() || from.triangles.empty()) return {};
   Tree tree(target.begin(), target.end());
   tree.accelerate_distance_queries();
-  return farthest_from(from, tree, counts);
+  return farthest_from(from, tree, counts, collect_beyond_m);
 }
 
 double max_distance(const TriMesh& from, const TriMesh& to, const SampleFilter& counts) {
