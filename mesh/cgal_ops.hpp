@@ -35,6 +35,9 @@ FarthestSample farthest_sample(const TriMesh& from, const TriMesh& to, const Sam
 
 // Pairs of intersecting triangles that share no vertex; 0 for a clean mesh.
 std::size_t count_self_intersections(const TriMesh& mesh);
+// Per triangle: whether it is degenerate (two corners on one point, or all three on a line) or
+// in one of those pairs.
+std::vector<bool> faulty_triangles(const TriMesh& mesh);
 
 // Re-meshes a closed shell where it folds through itself (CGAL's experimental self-intersection
 // removal: local smoothing and hole filling). False when folds remain or the shell opens; then

@@ -17,12 +17,14 @@ inline void initialise_openvdb() {
 struct TriMeshAdapter {
   const TriMesh& mesh;
   double inverse_voxel;
+  Vec3 origin = Vec3::Zero();  // the world point of index (0, 0, 0) [m]
   std::size_t polygonCount() const { return mesh.triangles.size(); }
   std::size_t pointCount() const { return mesh.vertices.size(); }
   std::size_t vertexCount(std::size_t) const { return 3; }
   void getIndexSpacePoint(std::size_t n, std::size_t v, openvdb::Vec3d& pos) const {
     const Vec3& p = mesh.vertices[std::size_t(mesh.triangles[n][v])];
-    pos = openvdb::Vec3d(p.x(), p.y(), p.z()) * inverse_voxel;
+    const Vec3 q = p - origin;
+    pos = openvdb::Vec3d(q.x(), q.y(), q.z()) * inverse_voxel;
   }
 };
 

@@ -77,8 +77,15 @@ double signing_terms(const openvdb::FloatGrid& grid, const WindingNumber& windin
 // nothing where signing it would sum more than `max_terms` terms, whose estimate `terms` holds.
 openvdb::FloatGrid::Ptr signed_band(const TriMesh& soup, const WindingNumber& winding, double cell_m, float band,
                                     double max_terms, double& terms) {
+  // The samples are offset from the axes' origin by 1/π of a cell: CAD faces lie on round
+  // coordinates, and samples exactly on a face (distance 0, neither side) left OpenVDB's zero
+  // surface with sheets of no thickness. Unshifted, the flanged ring's solid at cells of 0.2 mm
+  // had 17 shells, 6,685 degenerate faces and 12,440 crossing triangle pairs; shifted, its zero
+  // surface crosses nowhere and the solid is one shell.
   auto transform = openvdb::math::Transform::createLinearTransform(cell_m);
-  const TriMeshAdapter adapter{soup, 1.0 / cell_m};
+  const Vec3 origin = Vec3::Constant(0.318309886 * cell_m);
+  transform->postTranslate(openvdb::Vec3d(origin.x(), origin.y(), origin.z()));
+  const TriMeshAdapter adapter{soup, 1.0 / cell_m, origin};
   openvdb::FloatGrid::Ptr grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
       adapter, *transform, band, band, openvdb::tools::UNSIGNED_DISTANCE_FIELD);
   terms = signing_terms(*grid, winding);
@@ -133,6 +140,24 @@ bool has_boundary(const TriMesh& mesh) {
   return std::any_of(uses.begin(), uses.end(), [](const auto& use) { return use.second == 1; });
 }
 
+// Where the input is thinner than a cell (the two sides of a slit) or comes to an edge between
+// cells, moving the zero surface onto it folds it: triangles turned over through their
+// neighbours, or flattened onto a line (the flanged ring at cells of 0.2 mm: 1,658 crossing
+// pairs, none before the move). The corners of every such triangle go back where the zero
+// surface had them, until none is left: the zero surface crosses nowhere, so this ends.
+void put_back_folds(TriMesh& mesh, const std::vector<Vec3>& unmoved) {
+  for (;;) {
+    const std::vector<bool> faulty = faulty_triangles(mesh);
+    std::size_t put_back = 0;
+    for (std::size_t f = 0; f < faulty.size(); ++f) {
+      if (!faulty[f]) continue;
+      for (const int v : mesh.triangles[f])
+        if (mesh.vertices[std::size_t(v)] != unmoved[std::size_t(v)]) mesh.vertices[std::size_t(v)] = unmoved[std::size_t(v)], ++put_back;
+    }
+    if (put_back == 0) return;
+  }
+}
+
 // `zero` with its vertices moved onto the closest input point, and how far that leaves the
 // input's bounding surface from it; `beyond` (if given) receives the input's sample points left
 // farther than a cell from it.
@@ -141,10 +166,12 @@ WindingSolid on_input(TriMesh zero, const TriMesh& soup, const ExactSurface& sur
   // The zero surface cuts corners by up to a cell; its vertices moved onto the closest input
   // point lie on the surface the file means, sharp edges and flat faces included (a flat top
   // face stays exactly flat, which the die's opening needs).
+  const std::vector<Vec3> unmoved = zero.vertices;
   tbb::parallel_for(std::size_t(0), zero.vertices.size(), [&](std::size_t v) {
     const Vec3 closest = surface.closest_point(zero.vertices[v]);
     if ((closest - zero.vertices[v]).norm() <= cell_m) zero.vertices[v] = closest;
   });
+  put_back_folds(zero, unmoved);
   // What bounds the region in the input: sample points whose two sides fall on either side
   // of ½ (a quarter cell off the face); faces buried inside or left in the open do not.
   const double offset = 0.25 * cell_m;
