@@ -240,6 +240,13 @@ std::optional<TriMesh> winding_number_solid(const SurfaceMesh& sm, const MeshRep
     return std::nullopt;
   }
   if (solid.mesh.triangles.empty()) return std::nullopt;
+  if (!solid.folded_at.empty()) {
+    const Vec3 at = 1e3 * solid.folded_at.front();
+    defect += fmt::format("; re-meshed on cells of {} as the solid its winding number encloses, it would cross itself "
+                          "at ({:.4g}, {:.4g}, {:.4g}) mm",
+                          mm(cell), at.x(), at.y(), at.z());
+    return std::nullopt;
+  }
   if (solid.moved_m > options.tolerance_m) {
     const Vec3 at = 1e3 * solid.moved_most_at;
     defect += fmt::format("; re-meshed on cells of {} as the solid its winding number encloses, it would move the "

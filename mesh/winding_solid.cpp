@@ -144,17 +144,27 @@ bool has_boundary(const TriMesh& mesh) {
 // cells, moving the zero surface onto it folds it: triangles turned over through their
 // neighbours, or flattened onto a line (the flanged ring at cells of 0.2 mm: 1,658 crossing
 // pairs, none before the move). The corners of every such triangle go back where the zero
-// surface had them, until none is left: the zero surface crosses nowhere, so this ends.
-void put_back_folds(TriMesh& mesh, const std::vector<Vec3>& unmoved) {
-  for (;;) {
+// surface had them, until none is left or only the zero surface's own are: returns the corners
+// of those (OpenVDB's merged cells crossed in 3 pairs on the sprocket of the shared dies).
+// Corners put on the bounding box's face (`on_box`) go back last: put back first, they left the
+// flanged ring's opening 0.19 mm proud of its plane, with no flat top face.
+std::vector<Vec3> put_back_folds(TriMesh& mesh, const std::vector<Vec3>& unmoved, const std::vector<char>& on_box) {
+  for (bool box_too = false;;) {
     const std::vector<bool> faulty = faulty_triangles(mesh);
-    std::size_t put_back = 0;
+    std::size_t put_back = 0, left_on_box = 0;
+    std::vector<Vec3> unmoved_faulty;
     for (std::size_t f = 0; f < faulty.size(); ++f) {
       if (!faulty[f]) continue;
-      for (const int v : mesh.triangles[f])
-        if (mesh.vertices[std::size_t(v)] != unmoved[std::size_t(v)]) mesh.vertices[std::size_t(v)] = unmoved[std::size_t(v)], ++put_back;
+      for (const int corner : mesh.triangles[f]) {
+        const std::size_t v = std::size_t(corner);
+        if (mesh.vertices[v] == unmoved[v]) unmoved_faulty.push_back(mesh.vertices[v]);
+        else if (box_too || !on_box[v]) mesh.vertices[v] = unmoved[v], ++put_back;
+        else ++left_on_box;
+      }
     }
-    if (put_back == 0) return;
+    if (put_back > 0) continue;
+    if (left_on_box == 0) return unmoved_faulty;
+    box_too = true;
   }
 }
 
@@ -166,16 +176,29 @@ WindingSolid on_input(TriMesh zero, const TriMesh& soup, const ExactSurface& sur
   // The zero surface cuts corners by up to a cell; its vertices moved onto the closest input
   // point lie on the surface the file means, sharp edges and flat faces included (a flat top
   // face stays exactly flat, which the die's opening needs).
+  // Where the file has no face within a cell (a face missing from it), the zero surface closes
+  // the gap within a cell of where the face was, not on it; at the part's extremes that face was
+  // flat (the flanged ring of the shared dies lacks its flange face, the side the die opens on),
+  // so such vertices within a cell of the input's bounding box go onto the box's face.
+  const Box box = bounding_box(soup);
   const std::vector<Vec3> unmoved = zero.vertices;
+  std::vector<char> on_box(zero.vertices.size(), 0);
   tbb::parallel_for(std::size_t(0), zero.vertices.size(), [&](std::size_t v) {
-    const Vec3 closest = surface.closest_point(zero.vertices[v]);
-    if ((closest - zero.vertices[v]).norm() <= cell_m) zero.vertices[v] = closest;
+    Vec3& p = zero.vertices[v];
+    const Vec3 closest = surface.closest_point(p);
+    if ((closest - p).norm() <= cell_m) {
+      p = closest;
+      return;
+    }
+    for (int axis = 0; axis < 3; ++axis)
+      for (const double extreme : {box.lo[axis], box.hi[axis]})
+        if (std::abs(p[axis] - extreme) <= cell_m) p[axis] = extreme, on_box[v] = 1;
   });
-  put_back_folds(zero, unmoved);
+  WindingSolid out;
+  out.folded_at = put_back_folds(zero, unmoved, on_box);
   // What bounds the region in the input: sample points whose two sides fall on either side
   // of ½ (a quarter cell off the face); faces buried inside or left in the open do not.
   const double offset = 0.25 * cell_m;
-  WindingSolid out;
   FarthestSample moved = farthest_sample(
       soup, zero,
       [&](const Vec3& p, const Vec3& normal) {
@@ -284,26 +307,29 @@ constexpr int survey_block_cells = 16;
 // The zero surface with flat regions' cells merged (ten times fewer triangles on the open gear
 // of the shared dies), and fine cells wherever merging left the input's surface more than a cell
 // away: the sprocket's open visual mesh at cells of 1 mm, meshed fine everywhere, was 2.3 million
-// triangles, most of its repair's and its field's cost. Nothing where the merged surface is
-// empty, open, or still moved beyond a cell once fine cells stop helping (the planetary gear
-// set: gears fused across a gap narrower than a cell, which no cell size here undoes).
+// triangles, most of its repair's and its field's cost; fine cells also where merged ones cross
+// each other. Nothing where the merged surface is empty, open, or still moved beyond a cell or
+// crossing once fine cells stop helping (the planetary gear set: gears fused across a gap
+// narrower than a cell, which no cell size here undoes).
 std::optional<WindingSolid> merged_where_flat(const openvdb::FloatGrid& grid, const TriMesh& soup,
                                               const ExactSurface& surface, const WindingNumber& winding, double cell_m) {
   constexpr int most_rounds = 3;
   const auto fine = std::make_shared<openvdb::BoolTree>(false);
   std::vector<Vec3> beyond;
   double moved_before = std::numeric_limits<double>::infinity();
+  std::size_t folded_before = std::numeric_limits<std::size_t>::max();
   for (int round = 0; round <= most_rounds; ++round) {
     TriMesh zero = zero_surface(grid, flat_adaptivity, round == 0 ? nullptr : fine);
     if (zero.triangles.empty() || has_boundary(zero)) return std::nullopt;
     WindingSolid solid = on_input(std::move(zero), soup, surface, winding, cell_m, &beyond);
     diefill::log::debug("repair: winding-number solid, merged where flat (round {}): {} triangles, moved {:.4g} mm, "
-                        "{} input samples beyond a cell",
-                        round, solid.mesh.triangles.size(), solid.moved_m * 1e3, beyond.size());
-    if (solid.moved_m <= cell_m) return solid;
-    if (solid.moved_m >= moved_before) return std::nullopt;
-    moved_before = solid.moved_m;
+                        "{} input samples beyond a cell, {} corners of crossing triangles",
+                        round, solid.mesh.triangles.size(), solid.moved_m * 1e3, beyond.size(), solid.folded_at.size());
+    if (solid.moved_m <= cell_m && solid.folded_at.empty()) return solid;
+    if (solid.moved_m >= moved_before && solid.folded_at.size() >= folded_before) return std::nullopt;
+    moved_before = solid.moved_m, folded_before = solid.folded_at.size();
     mark_fine(*fine, beyond, grid.transform());
+    mark_fine(*fine, solid.folded_at, grid.transform());
   }
   return std::nullopt;
 }
@@ -350,7 +376,11 @@ WindingSolid winding_solid(const TriMesh& soup, double cell_m, double max_terms)
   for (float band = band_cells; band <= widest_band_cells; band *= 2) {
     double terms = 0.0;
     const openvdb::FloatGrid::Ptr grid = signed_band(soup, winding, cell_m, band, max_terms - spent, terms);
-    if (!grid) return WindingSolid{{}, 0.0, spent + terms};
+    if (!grid) {
+      WindingSolid refused;
+      refused.refused_terms = spent + terms;
+      return refused;
+    }
     spent += terms;
     if (std::optional<WindingSolid> solid = merged_where_flat(*grid, soup, surface, winding, cell_m)) return *solid;
     // Every cell fine.

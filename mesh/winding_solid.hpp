@@ -20,7 +20,7 @@ struct WindingSurvey {
 WindingSurvey survey_winding(const TriMesh& soup, int cells = 96);
 
 struct WindingSolid {
-  TriMesh mesh;  // closed, outward; empty when the region is empty or could not be closed
+  TriMesh mesh;  // closed, outward, crossing nowhere (else folded_at says where); empty when the region is empty or could not be closed
   // Largest distance from the input's bounding surface (points whose two sides the winding
   // number puts on different sides of ½) to the result [m]: how far the re-meshing moved it.
   double moved_m = 0.0;
@@ -28,6 +28,9 @@ struct WindingSolid {
   // more than allowed: the mesh is empty then.
   double refused_terms = 0.0;
   Vec3 moved_most_at = Vec3::Zero();  // the input point `moved_m` was measured at [m]
+  // Corners of triangles that cross others or are degenerate [m]: empty, unless OpenVDB's zero
+  // surface crossed itself there (repair refuses the mesh then).
+  std::vector<Vec3> folded_at;
 };
 
 // The region of `soup` with winding number ≥ ½, meshed on cells of `cell_m` (OpenVDB: the
