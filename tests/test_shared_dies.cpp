@@ -164,7 +164,8 @@ TEST(SharedDieOpenings, AreTheFacesThatOpenTheOutline) {
 // solid closes it flat in the plane of the face's rim, so the die has a flat top face to fill
 // through (before, the patch lay within a cell of that plane, not in it, and the die was refused).
 // At the voxels of the README's run of it (0.365 mm); at 0.8 mm a small shell of the file beside
-// the opening is re-meshed 0.19 mm proud of the plane, the box's top (README, "Shared dies").
+// the opening is re-meshed 0.19 mm proud of the plane, the box's top (README, "Shared dies through
+// the pipeline").
 TEST(SharedDieOpenings, AFaceMissingFromTheFileAtTheOpeningIsClosedFlat) {
   REQUIRE_SHARED_MESHES();
   mesh::DieOptions o = mesh::die_options_for_grains(0.5e-3, 0.25e-3, 0.365e-3);
