@@ -240,20 +240,16 @@ std::optional<TriMesh> winding_number_solid(const SurfaceMesh& sm, const MeshRep
     return std::nullopt;
   }
   if (solid.mesh.triangles.empty()) return std::nullopt;
-  if (!solid.folded_at.empty()) {
-    const Vec3 at = 1e3 * solid.folded_at.front();
-    defect += fmt::format("; re-meshed on cells of {} as the solid its winding number encloses, it would cross itself "
-                          "at ({:.4g}, {:.4g}, {:.4g}) mm",
-                          mm(cell), at.x(), at.y(), at.z());
+  const auto refused = [&](const std::string& what, const Vec3& where_m) {
+    const Vec3 at = 1e3 * where_m;
+    defect += fmt::format("; re-meshed on cells of {} as the solid its winding number encloses, it would {} at ({:.4g}, "
+                          "{:.4g}, {:.4g}) mm",
+                          mm(cell), what, at.x(), at.y(), at.z());
     return std::nullopt;
-  }
-  if (solid.moved_m > options.tolerance_m) {
-    const Vec3 at = 1e3 * solid.moved_most_at;
-    defect += fmt::format("; re-meshed on cells of {} as the solid its winding number encloses, it would move the "
-                          "surface by {} at ({:.4g}, {:.4g}, {:.4g}) mm",
-                          mm(cell), mm(solid.moved_m), at.x(), at.y(), at.z());
-    return std::nullopt;
-  }
+  };
+  if (!solid.folded_at.empty()) return refused("cross itself", solid.folded_at.front());
+  if (solid.moved_m > options.tolerance_m)
+    return refused(fmt::format("move the surface by {}", mm(solid.moved_m)), solid.moved_most_at);
   result.actions.push_back(fmt::format(
       "{}: re-meshed as the solid its winding number encloses (cells of {}; ambiguous volume {:.4g} mm³, "
       "{:.3g} % of the solid)",

@@ -18,11 +18,11 @@
 #include <memory>
 #include <unordered_map>
 
+#include "core/log.hpp"
 #include "mesh/cgal_ops.hpp"
 #include "mesh/exact.hpp"
 #include "mesh/openvdb_adapter.hpp"
 #include "mesh/winding.hpp"
-#include "core/log.hpp"
 
 namespace mesh::detail {
 
@@ -146,25 +146,20 @@ bool has_boundary(const TriMesh& mesh) {
 // pairs, none before the move). The corners of every such triangle go back where the zero
 // surface had them, until none is left or only the zero surface's own are: returns the corners
 // of those (OpenVDB's merged cells crossed in 3 pairs on the sprocket of the shared dies).
-// Corners put on the bounding box's face (`on_box`) go back last: put back first, they left the
-// flanged ring's opening 0.19 mm proud of its plane, with no flat top face.
-std::vector<Vec3> put_back_folds(TriMesh& mesh, const std::vector<Vec3>& unmoved, const std::vector<char>& on_box) {
-  for (bool box_too = false;;) {
+std::vector<Vec3> put_back_folds(TriMesh& mesh, const std::vector<Vec3>& unmoved) {
+  for (;;) {
     const std::vector<bool> faulty = faulty_triangles(mesh);
-    std::size_t put_back = 0, left_on_box = 0;
+    std::size_t put_back = 0;
     std::vector<Vec3> unmoved_faulty;
     for (std::size_t f = 0; f < faulty.size(); ++f) {
       if (!faulty[f]) continue;
       for (const int corner : mesh.triangles[f]) {
-        const std::size_t v = std::size_t(corner);
-        if (mesh.vertices[v] == unmoved[v]) unmoved_faulty.push_back(mesh.vertices[v]);
-        else if (box_too || !on_box[v]) mesh.vertices[v] = unmoved[v], ++put_back;
-        else ++left_on_box;
+        Vec3& p = mesh.vertices[std::size_t(corner)];
+        if (p == unmoved[std::size_t(corner)]) unmoved_faulty.push_back(p);
+        else p = unmoved[std::size_t(corner)], ++put_back;
       }
     }
-    if (put_back > 0) continue;
-    if (left_on_box == 0) return unmoved_faulty;
-    box_too = true;
+    if (put_back == 0) return unmoved_faulty;
   }
 }
 
@@ -182,7 +177,6 @@ WindingSolid on_input(TriMesh zero, const TriMesh& soup, const ExactSurface& sur
   // so such vertices within a cell of the input's bounding box go onto the box's face.
   const Box box = bounding_box(soup);
   const std::vector<Vec3> unmoved = zero.vertices;
-  std::vector<char> on_box(zero.vertices.size(), 0);
   tbb::parallel_for(std::size_t(0), zero.vertices.size(), [&](std::size_t v) {
     Vec3& p = zero.vertices[v];
     const Vec3 closest = surface.closest_point(p);
@@ -192,10 +186,10 @@ WindingSolid on_input(TriMesh zero, const TriMesh& soup, const ExactSurface& sur
     }
     for (int axis = 0; axis < 3; ++axis)
       for (const double extreme : {box.lo[axis], box.hi[axis]})
-        if (std::abs(p[axis] - extreme) <= cell_m) p[axis] = extreme, on_box[v] = 1;
+        if (std::abs(p[axis] - extreme) <= cell_m) p[axis] = extreme;
   });
   WindingSolid out;
-  out.folded_at = put_back_folds(zero, unmoved, on_box);
+  out.folded_at = put_back_folds(zero, unmoved);
   // What bounds the region in the input: sample points whose two sides fall on either side
   // of ½ (a quarter cell off the face); faces buried inside or left in the open do not.
   const double offset = 0.25 * cell_m;

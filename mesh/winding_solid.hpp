@@ -20,7 +20,9 @@ struct WindingSurvey {
 WindingSurvey survey_winding(const TriMesh& soup, int cells = 96);
 
 struct WindingSolid {
-  TriMesh mesh;  // closed, outward, crossing nowhere (else folded_at says where); empty when the region is empty or could not be closed
+  // Closed, outward, crossing nowhere (else folded_at says where); empty when the region is
+  // empty or could not be closed.
+  TriMesh mesh;
   // Largest distance from the input's bounding surface (points whose two sides the winding
   // number puts on different sides of ½) to the result [m]: how far the re-meshing moved it.
   double moved_m = 0.0;
