@@ -28,6 +28,7 @@ double max_distance(const TriMesh& from, const TriMesh& to, const SampleFilter& 
 struct FarthestSample {
   double distance_m = 0.0;
   Vec3 point = Vec3::Zero();
+  Vec3 normal = Vec3::Zero();  // of the face `point` lies on
   std::vector<Vec3> beyond;
 };
 FarthestSample farthest_sample(const TriMesh& from, const TriMesh& to, const SampleFilter& counts,

@@ -2,6 +2,7 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -131,15 +132,17 @@ DieOptions die_options_for_grains(double grain_radius_m, double skin_m, std::opt
   o.interior_band_m = 3.0 * o.voxel_m;
   o.repair.tolerance_m = 0.5 * o.voxel_m;
   o.repair.max_hole_m = 10.0 * o.voxel_m;
+  // A gap narrower than a voxel the field cannot show, and none narrower than a grain admits one.
+  o.repair.closable_gap_m = std::min(o.voxel_m, 2.0 * grain_radius_m);
   return o;
 }
 
 std::string die_cache_key(const std::string& file_sha256, Up up, const DieOptions& o) {
   std::string text = fmt::format(
       "format={};sha={};unit={};up={};role={};voxel={:.17g};ext={:.17g};int={:.17g};tol={:.17g};"
-      "hole={:.17g};wrap={};margin={:.17g}",
+      "hole={:.17g};gap={:.17g};wrap={};margin={:.17g}",
       cache_format, file_sha256, unit_name(o.unit), up_name(up), role_name(o.role), o.voxel_m, o.exterior_band_m,
-      o.interior_band_m, o.repair.tolerance_m, o.repair.max_hole_m, o.repair.allow_wrap,
+      o.interior_band_m, o.repair.tolerance_m, o.repair.max_hole_m, o.repair.closable_gap_m, o.repair.allow_wrap,
       o.table_margin_m);
   if (o.table)
     text += fmt::format(";table={:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", o.table->x_min,
@@ -216,7 +219,9 @@ PreparedDie prepare_die(const DieFile& file, const DieOptions& options, const st
     }
   }
 
-  RepairResult repaired = repair(file.mesh, options.repair, source);
+  RepairOptions repair_options = options.repair;
+  repair_options.free_space_inside = options.role != WallRole::tool;
+  RepairResult repaired = repair(file.mesh, repair_options, source);
   out.before = repaired.before;
   out.after = repaired.after;
   out.actions = repaired.actions;

@@ -228,7 +228,8 @@ std::optional<TriMesh> winding_number_solid(const SurfaceMesh& sm, const MeshRep
                                  b.lo.z() * 1e3, b.hi.x() * 1e3, b.hi.y() * 1e3, b.hi.z() * 1e3),
                      "Close the mesh in CAD there");
   }
-  detail::WindingSolid solid = detail::winding_solid(soup, cell, max_winding_terms);
+  detail::WindingSolid solid =
+      detail::winding_solid(soup, cell, {options.closable_gap_m, options.free_space_inside}, max_winding_terms);
   diefill::log::debug("repair: winding-number solid ({} triangles, moved {}) in {:.2f} s",
                       solid.mesh.triangles.size(), mm(solid.moved_m), clock.seconds());
   if (solid.refused_terms > 0) {
@@ -240,20 +241,31 @@ std::optional<TriMesh> winding_number_solid(const SurfaceMesh& sm, const MeshRep
     return std::nullopt;
   }
   if (solid.mesh.triangles.empty()) return std::nullopt;
-  const auto refused = [&](const std::string& what, const Vec3& where_m) {
+  const auto refused = [&](const std::string& what, const Vec3& where_m, const std::string& there = "") {
     const Vec3 at = 1e3 * where_m;
     defect += fmt::format("; re-meshed on cells of {} as the solid its winding number encloses, it would {} at ({:.4g}, "
-                          "{:.4g}, {:.4g}) mm",
-                          mm(cell), what, at.x(), at.y(), at.z());
+                          "{:.4g}, {:.4g}) mm{}",
+                          mm(cell), what, at.x(), at.y(), at.z(), there);
     return std::nullopt;
   };
   if (!solid.folded_at.empty()) return refused("cross itself", solid.folded_at.front());
   if (solid.moved_m > options.tolerance_m)
-    return refused(fmt::format("move the surface by {}", mm(solid.moved_m)), solid.moved_most_at);
+    return refused(fmt::format("move the surface by {}", mm(solid.moved_m)), solid.moved_most_at,
+                   !solid.moved_across_thin_solid ? ""
+                   : fmt::format(", where {} is thinner than {} and the cells join what it parts",
+                                 options.free_space_inside ? "the die's wall between two parts of the cavity" : "the solid",
+                                 mm(options.closable_gap_m)));
   result.actions.push_back(fmt::format(
       "{}: re-meshed as the solid its winding number encloses (cells of {}; ambiguous volume {:.4g} mm³, "
       "{:.3g} % of the solid)",
       defect, mm(cell), survey.ambiguous_volume_m3 * 1e9, 100 * survey.ambiguous_volume_m3 / survey.solid_volume_m3));
+  if (solid.gap_closed_m > solid.moved_m) {
+    const Vec3 at = 1e3 * solid.gap_closed_at;
+    result.actions.push_back(fmt::format(
+        "closed gaps of the free space no grain {} across can touch the surface in: their faces lie up to {} from "
+        "the result, at ({:.4g}, {:.4g}, {:.4g}) mm",
+        mm(options.closable_gap_m), mm(solid.gap_closed_m), at.x(), at.y(), at.z()));
+  }
   result.winding_moved_m = solid.moved_m;
   return std::move(solid.mesh);
 }

@@ -34,6 +34,12 @@ struct RepairOptions {
   double tolerance_m = 5e-5;      // largest surface displacement repair may introduce
   double max_hole_m = 1e-3;       // holes up to this diameter are filled
   bool allow_wrap = true;         // fall back to alpha wrapping for what stays broken
+  // A re-mesh may cover the surface where no grain of this diameter can touch it from the free
+  // space (where grains move: the solid's inside for a cavity or a container, its outside for a
+  // tool): a gap too narrow to enter (die_options_for_grains). Not counted as moving the surface;
+  // reported.
+  double closable_gap_m = 0.0;
+  bool free_space_inside = true;
 };
 
 // Repair limits for a grain mesh clumped at the relative `clump_tolerance`: repair may move

@@ -164,10 +164,10 @@ std::vector<Vec3> put_back_folds(TriMesh& mesh, const std::vector<Vec3>& unmoved
 }
 
 // `zero` with its vertices moved onto the closest input point, and how far that leaves the
-// input's bounding surface from it; `beyond` (if given) receives the input's sample points left
-// farther than a cell from it.
+// input's bounding surface from it, not counting the faces of `gaps` it closed; `beyond` (if
+// given) receives the input's sample points left farther than a cell from it.
 WindingSolid on_input(TriMesh zero, const TriMesh& soup, const ExactSurface& surface, const WindingNumber& winding,
-                      double cell_m, std::vector<Vec3>* beyond = nullptr) {
+                      double cell_m, const ClosableGaps& gaps, std::vector<Vec3>* beyond = nullptr) {
   // The zero surface cuts corners by up to a cell; its vertices moved onto the closest input
   // point lie on the surface the file means, sharp edges and flat faces included (a flat top
   // face stays exactly flat, which the die's opening needs).
@@ -191,14 +191,47 @@ WindingSolid on_input(TriMesh zero, const TriMesh& soup, const ExactSurface& sur
   WindingSolid out;
   out.folded_at = put_back_folds(zero, unmoved);
   // What bounds the region in the input: sample points whose two sides fall on either side
-  // of ½ (a quarter cell off the face); faces buried inside or left in the open do not.
+  // of ½ (a quarter cell off the face); faces buried inside or left in the open do not. Nor do
+  // those the result covers where no grain of the closable diameter can touch them from the free
+  // space (`gaps`): there the cells are too coarse to keep the free space open, and no grain
+  // could tell (README, "Mesh repair").
   const double offset = 0.25 * cell_m;
+  const double grain = 0.5 * gaps.closable_m;  // radius
+  // Whether no grain of the closable diameter touches `p`, on a face of unit `normal` with the
+  // solid on that side or not, from the free space (inside the solid or not).
+  const auto untouchable = [&](const Vec3& p, const Vec3& normal, bool solid_ahead, bool free_space_inside) {
+    const auto free_at = [&](const Vec3& x) { return (winding(x) >= 0.5) == free_space_inside; };
+    const Vec3 centre = p + (solid_ahead == free_space_inside ? grain : -grain) * normal;
+    if (!free_at(centre)) return true;
+    const Vec3 nearest = surface.closest_point(centre);
+    const double clearance = (nearest - centre).norm();
+    if (clearance >= 0.999 * grain) return false;  // the grain fits
+    // What it overlaps must bound the free space, not lie in the open: just beyond it (a
+    // hundredth of the grain: the solid there may be a sliver) is not free space. A centre on
+    // a face, as at a sample on an edge, overlaps that face.
+    return clearance <= 1e-3 * grain || !free_at(nearest + 1e-2 * grain / clearance * (nearest - centre));
+  };
+  std::unique_ptr<ExactSurface> result;  // built on the first sample that needs it
+  std::vector<Vec3> gap_faces;
   FarthestSample moved = farthest_sample(
       soup, zero,
       [&](const Vec3& p, const Vec3& normal) {
-        return (winding(p + offset * normal) >= 0.5) != (winding(p - offset * normal) >= 0.5);
+        const bool solid_ahead = winding(p + offset * normal) >= 0.5;
+        if (solid_ahead == (winding(p - offset * normal) >= 0.5)) return false;
+        if (grain <= 0.0 || !untouchable(p, normal, solid_ahead, gaps.free_space_inside)) return true;
+        if (!result) result = std::make_unique<ExactSurface>(zero);
+        if (result->inside(p) == gaps.free_space_inside) return true;  // the result keeps the free space
+        gap_faces.push_back(p);
+        return false;
       },
       beyond ? cell_m : std::numeric_limits<double>::infinity());
+  for (const Vec3& p : gap_faces) {
+    const double depth = result->distance(p);
+    if (depth > out.gap_closed_m) out.gap_closed_m = depth, out.gap_closed_at = p;
+  }
+  out.moved_across_thin_solid =
+      grain > 0.0 && moved.distance_m > 0.0 &&
+      untouchable(moved.point, moved.normal, winding(moved.point + offset * moved.normal) >= 0.5, !gaps.free_space_inside);
   if (beyond) *beyond = std::move(moved.beyond);
   out.moved_m = moved.distance_m;
   out.moved_most_at = moved.point;
@@ -306,7 +339,8 @@ constexpr int survey_block_cells = 16;
 // crossing once fine cells stop helping (the planetary gear set: gears fused across a gap
 // narrower than a cell, which no cell size here undoes).
 std::optional<WindingSolid> merged_where_flat(const openvdb::FloatGrid& grid, const TriMesh& soup,
-                                              const ExactSurface& surface, const WindingNumber& winding, double cell_m) {
+                                              const ExactSurface& surface, const WindingNumber& winding, double cell_m,
+                                              const ClosableGaps& gaps) {
   constexpr int most_rounds = 3;
   const auto fine = std::make_shared<openvdb::BoolTree>(false);
   std::vector<Vec3> beyond;
@@ -315,10 +349,12 @@ std::optional<WindingSolid> merged_where_flat(const openvdb::FloatGrid& grid, co
   for (int round = 0; round <= most_rounds; ++round) {
     TriMesh zero = zero_surface(grid, flat_adaptivity, round == 0 ? nullptr : fine);
     if (zero.triangles.empty() || has_boundary(zero)) return std::nullopt;
-    WindingSolid solid = on_input(std::move(zero), soup, surface, winding, cell_m, &beyond);
-    diefill::log::debug("repair: winding-number solid, merged where flat (round {}): {} triangles, moved {:.4g} mm, "
-                        "{} input samples beyond a cell, {} corners of crossing triangles",
-                        round, solid.mesh.triangles.size(), solid.moved_m * 1e3, beyond.size(), solid.folded_at.size());
+    WindingSolid solid = on_input(std::move(zero), soup, surface, winding, cell_m, gaps, &beyond);
+    diefill::log::debug("repair: winding-number solid, merged where flat (round {}): {} triangles, moved {:.4g} mm at "
+                        "({:.4g}, {:.4g}, {:.4g}) mm, {} input samples beyond a cell, {} corners of crossing triangles",
+                        round, solid.mesh.triangles.size(), solid.moved_m * 1e3, solid.moved_most_at.x() * 1e3,
+                        solid.moved_most_at.y() * 1e3, solid.moved_most_at.z() * 1e3, beyond.size(),
+                        solid.folded_at.size());
     if (solid.moved_m <= cell_m && solid.folded_at.empty()) return solid;
     if (solid.moved_m >= moved_before && solid.folded_at.size() >= folded_before) return std::nullopt;
     moved_before = solid.moved_m, folded_before = solid.folded_at.size();
@@ -362,7 +398,7 @@ double winding_solid_cells(double surface_area_m2, double cell_m) {
   return 2.0 * double(band_cells) * surface_area_m2 / (cell_m * cell_m);
 }
 
-WindingSolid winding_solid(const TriMesh& soup, double cell_m, double max_terms) {
+WindingSolid winding_solid(const TriMesh& soup, double cell_m, const ClosableGaps& gaps, double max_terms) {
   initialise_openvdb();
   const WindingNumber winding(soup);
   const ExactSurface surface(soup);
@@ -376,11 +412,11 @@ WindingSolid winding_solid(const TriMesh& soup, double cell_m, double max_terms)
       return refused;
     }
     spent += terms;
-    if (std::optional<WindingSolid> solid = merged_where_flat(*grid, soup, surface, winding, cell_m)) return *solid;
+    if (std::optional<WindingSolid> solid = merged_where_flat(*grid, soup, surface, winding, cell_m, gaps)) return *solid;
     // Every cell fine.
     TriMesh zero = zero_surface(*grid, 0.0);
     if (zero.triangles.empty()) return {};  // nothing has winding number ≥ ½
-    if (!has_boundary(zero)) return on_input(std::move(zero), soup, surface, winding, cell_m);
+    if (!has_boundary(zero)) return on_input(std::move(zero), soup, surface, winding, cell_m, gaps);
   }
   return {};  // not closed within the widest band
 }

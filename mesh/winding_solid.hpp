@@ -30,15 +30,30 @@ struct WindingSolid {
   // more than allowed: the mesh is empty then.
   double refused_terms = 0.0;
   Vec3 moved_most_at = Vec3::Zero();  // the input point `moved_m` was measured at [m]
+  // Faces of closable gaps the result closed, not counted in `moved_m`: the farthest such
+  // point's distance from the result [m], exact where it exceeds `moved_m` (else at most that),
+  // and the point.
+  double gap_closed_m = 0.0;
+  Vec3 gap_closed_at = Vec3::Zero();
+  // Whether the solid at `moved_most_at` is thinner than the closable diameter: the re-mesh
+  // joined two parts of the free space across it (a die wall between two cavities).
+  bool moved_across_thin_solid = false;
   // Corners of triangles that cross others or are degenerate [m]: empty, unless OpenVDB's zero
   // surface crossed itself there (repair refuses the mesh then).
   std::vector<Vec3> folded_at;
 };
 
+// The free space (where grains move: the solid's inside for a cavity or a container, its outside
+// for a tool) a re-mesh may close where no grain of diameter `closable_m` touches the surface.
+struct ClosableGaps {
+  double closable_m = 0.0;
+  bool free_space_inside = false;
+};
+
 // The region of `soup` with winding number ≥ ½, meshed on cells of `cell_m` (OpenVDB: the
 // soup's unsigned distance signed by the winding number, then its zero surface), unless
-// signing it would sum more than `max_terms` winding-number terms.
-WindingSolid winding_solid(const TriMesh& soup, double cell_m, double max_terms);
+// signing it would sum more than `max_terms` winding-number terms; `gaps` may be closed.
+WindingSolid winding_solid(const TriMesh& soup, double cell_m, const ClosableGaps& gaps, double max_terms);
 
 // Cells `winding_solid` would mesh, about: for refusing a re-mesh too fine to afford.
 double winding_solid_cells(double surface_area_m2, double cell_m);

@@ -45,7 +45,6 @@ FarthestSample farthest_from(const TriMesh& from, const Tree& tree, const Sample
   FarthestSample out;
   const double collect_squared = collect_beyond_m * collect_beyond_m;
   double worst_squared = 0.0;
-  Vec3 worst = Vec3::Zero();
   const double diagonal = bounding_box(from).size().norm();
   for (const Triangle& t : from.triangles) {
     const Vec3& a = from.vertices[t[0]];
@@ -63,12 +62,12 @@ FarthestSample farthest_from(const TriMesh& from, const Tree& tree, const Sample
         if (d2 > collect_squared) out.beyond.push_back(v);
         if (d2 > worst_squared) {
           worst_squared = d2;
-          worst = v;
+          out.point = v;
+          out.normal = normal;
         }
       }
   }
   out.distance_m = std::sqrt(worst_squared);
-  out.point = worst;
   return out;
 }
 }  // namespace

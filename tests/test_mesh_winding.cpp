@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <tuple>
 
 #include "core/error.hpp"
 #include "mesh/repair.hpp"
@@ -148,5 +149,58 @@ TEST(WindingSurvey, CountsAsEveryCellReadOneByOne) {
       EXPECT_LT((survey.ambiguous_box.hi - ambiguous_box.hi).norm(), 1e-6 * h);
     }
     EXPECT_GT(solid, 0);
+  }
+}
+
+// The re-mesh's samples lie 0.159 mm (1/π of a cell) off multiples of its 0.5 mm cells: none in
+// a gap from x = 10 to 10.15 mm between two blocks (wider than the quarter cell off a face at
+// which what bounds the solid is told) or in a plate 0.2 mm thick around z = 5 mm. The re-mesh
+// fills the gap and drops the plate. Either is free space no grain 0.5 mm
+// across touches: a gap between the blocks of a tool, a thin slot of a cavity; for the other
+// role it is the solid, and losing it moves the surface. The faces left 5 mm from the result
+// are the gap's middle (5 mm from the sides of the block the two become) and the plate's tip
+// (5 mm from the block it stood out of).
+TEST(WindingSolid, ClosesOnlyFreeSpaceNoGrainOfTheClosableDiameterTouches) {
+  const double cell = 0.5e-3;
+  const mesh::TriMesh gap = test::joined(test::box_mm(0, 10), mesh::box_solid(mm(10.15, 0, 0), mm(20, 10, 10)));
+  const mesh::TriMesh plate = test::joined(test::box_mm(0, 10), mesh::box_solid(mm(10, 0, 4.9), mm(15, 10, 5.1)));
+  const mesh::detail::ClosableGaps tool{cell, false}, cavity{cell, true};
+  for (const auto& [soup, free_space, other_role] : {std::tuple{gap, tool, cavity}, std::tuple{plate, cavity, tool}}) {
+    const mesh::detail::WindingSolid closed = mesh::detail::winding_solid(soup, cell, free_space, 2e9);
+    EXPECT_LE(closed.moved_m, cell) << closed.moved_most_at.transpose() * 1e3;
+    EXPECT_NEAR(closed.gap_closed_m, 5e-3, cell);
+    const mesh::detail::WindingSolid kept = mesh::detail::winding_solid(soup, cell, other_role, 2e9);
+    EXPECT_NEAR(kept.moved_m, 5e-3, cell);
+  }
+}
+
+// The same gap beside a cracked block (which takes repair to the winding-number solid): for a tool
+// repair closes it and says so; for a cavity it is a die wall 0.15 mm thick between two parts of
+// the cavity, which the cells would remove, and repair refuses, saying so.
+TEST(Repair, ClosesAGapNoGrainTouchesForAToolAndRefusesToJoinACavityAcrossAThinWall) {
+  mesh::TriMesh top;
+  top.vertices = {mm(0, 0, 10.05), mm(10, 0, 10.05), mm(10, 10, 10.05), mm(0, 10, 10.05)};
+  top.triangles = {{0, 1, 2}, {0, 2, 3}};
+  const mesh::TriMesh soup = test::joined(test::joined(without_top(test::box_mm(0, 10)), top),
+                                          mesh::box_solid(mm(10.15, 0, 0), mm(20, 10, 10)));
+  mesh::RepairOptions options;
+  options.tolerance_m = 0.5e-3;
+  options.max_hole_m = 2e-3;
+  options.closable_gap_m = 0.5e-3;
+  options.free_space_inside = false;
+  const mesh::RepairResult tool = mesh::repair(soup, options, "blocks.stl");
+  EXPECT_LE(tool.hausdorff_m, options.tolerance_m);
+  EXPECT_EQ(tool.after.shells, 1u);
+  EXPECT_NE(::testing::PrintToString(tool.actions).find("closed gaps of the free space no grain 0.5 mm across"),
+            std::string::npos)
+      << ::testing::PrintToString(tool.actions);
+  options.free_space_inside = true;
+  try {
+    mesh::repair(soup, options, "blocks.stl");
+    FAIL() << "a cavity joined across its wall";
+  } catch (const diefill::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("where the die's wall between two parts of the cavity is thinner than 0.5 mm"),
+              std::string::npos)
+        << e.what();
   }
 }
