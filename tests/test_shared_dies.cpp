@@ -42,7 +42,9 @@ const SharedDie shared_dies[] = {
     // 100 overlapping shells: 24·10⁹ winding-number terms at cells of 0.125 mm; at voxels of 0.9 mm
     // its winding-number solid (138 s) moves the surface 1.76 mm, and it is refused.
     {"toothed_pulley_hub_trimesh_cycloidal.ply", mesh::LengthUnit::in, "non-manifold edges"},
-    {"broken/assimp_3DSMaxExport.stl", mesh::LengthUnit::mm, "non-manifold edges"},
+    // 24 crossing shells: as a tool its winding-number solid closes the gaps between them that
+    // no grain a voxel across touches, and it loads (as a cavity it has no flat opening).
+    {"broken/assimp_3DSMaxExport.stl", mesh::LengthUnit::mm, nullptr},
     {"broken/assimp_Spider_ascii.stl", mesh::LengthUnit::mm, "boundary edges"},
     {"broken/assimp_sphereWithHole.stl", mesh::LengthUnit::mm, nullptr},  // winding number
     {"broken/assimp_triangle_with_two_solids.stl", mesh::LengthUnit::mm, "cannot enclose a solid"},
