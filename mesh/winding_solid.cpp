@@ -163,6 +163,28 @@ std::vector<Vec3> put_back_folds(TriMesh& mesh, const std::vector<Vec3>& unmoved
   }
 }
 
+// A grain of radius `radius_m` against the input: whether it can touch a point of its bounding
+// surface from the free space, which lies inside the solid or outside it.
+struct GrainProbe {
+  const WindingNumber& winding;
+  const ExactSurface& surface;
+  double radius_m;
+
+  // `p` lies on a face of unit `normal`, with the solid on that side or not.
+  bool touches(const Vec3& p, const Vec3& normal, bool solid_ahead, bool free_space_inside) const {
+    const auto free_at = [&](const Vec3& x) { return (winding(x) >= 0.5) == free_space_inside; };
+    const Vec3 centre = p + (solid_ahead == free_space_inside ? radius_m : -radius_m) * normal;
+    if (!free_at(centre)) return false;
+    const Vec3 nearest = surface.closest_point(centre);
+    const double clearance = (nearest - centre).norm();
+    if (clearance >= 0.999 * radius_m) return true;  // the grain fits
+    // What it overlaps must bound the free space, not lie in the open: just beyond it (a
+    // hundredth of the radius: the solid there may be a sliver) is not free space. A centre on
+    // a face, as at a sample on an edge, overlaps that face.
+    return clearance > 1e-3 * radius_m && free_at(nearest + 1e-2 * radius_m / clearance * (nearest - centre));
+  }
+};
+
 // `zero` with its vertices moved onto the closest input point, and how far that leaves the
 // input's bounding surface from it, not counting the faces of `gaps` it closed; `beyond` (if
 // given) receives the input's sample points left farther than a cell from it.
@@ -196,21 +218,7 @@ WindingSolid on_input(TriMesh zero, const TriMesh& soup, const ExactSurface& sur
   // space (`gaps`): there the cells are too coarse to keep the free space open, and no grain
   // could tell (README, "Mesh repair").
   const double offset = 0.25 * cell_m;
-  const double grain = 0.5 * gaps.closable_m;  // radius
-  // Whether no grain of the closable diameter touches `p`, on a face of unit `normal` with the
-  // solid on that side or not, from the free space (inside the solid or not).
-  const auto untouchable = [&](const Vec3& p, const Vec3& normal, bool solid_ahead, bool free_space_inside) {
-    const auto free_at = [&](const Vec3& x) { return (winding(x) >= 0.5) == free_space_inside; };
-    const Vec3 centre = p + (solid_ahead == free_space_inside ? grain : -grain) * normal;
-    if (!free_at(centre)) return true;
-    const Vec3 nearest = surface.closest_point(centre);
-    const double clearance = (nearest - centre).norm();
-    if (clearance >= 0.999 * grain) return false;  // the grain fits
-    // What it overlaps must bound the free space, not lie in the open: just beyond it (a
-    // hundredth of the grain: the solid there may be a sliver) is not free space. A centre on
-    // a face, as at a sample on an edge, overlaps that face.
-    return clearance <= 1e-3 * grain || !free_at(nearest + 1e-2 * grain / clearance * (nearest - centre));
-  };
+  const GrainProbe grain{winding, surface, 0.5 * gaps.closable_m};
   std::unique_ptr<ExactSurface> result;  // built on the first sample that needs it
   std::vector<Vec3> gap_faces;
   FarthestSample moved = farthest_sample(
@@ -218,7 +226,7 @@ WindingSolid on_input(TriMesh zero, const TriMesh& soup, const ExactSurface& sur
       [&](const Vec3& p, const Vec3& normal) {
         const bool solid_ahead = winding(p + offset * normal) >= 0.5;
         if (solid_ahead == (winding(p - offset * normal) >= 0.5)) return false;
-        if (grain <= 0.0 || !untouchable(p, normal, solid_ahead, gaps.free_space_inside)) return true;
+        if (grain.radius_m <= 0.0 || grain.touches(p, normal, solid_ahead, gaps.free_space_inside)) return true;
         if (!result) result = std::make_unique<ExactSurface>(zero);
         if (result->inside(p) == gaps.free_space_inside) return true;  // the result keeps the free space
         gap_faces.push_back(p);
@@ -229,9 +237,9 @@ WindingSolid on_input(TriMesh zero, const TriMesh& soup, const ExactSurface& sur
     const double depth = result->distance(p);
     if (depth > out.gap_closed_m) out.gap_closed_m = depth, out.gap_closed_at = p;
   }
-  out.moved_across_thin_solid =
-      grain > 0.0 && moved.distance_m > 0.0 &&
-      untouchable(moved.point, moved.normal, winding(moved.point + offset * moved.normal) >= 0.5, !gaps.free_space_inside);
+  out.moved_across_thin_solid = grain.radius_m > 0.0 && moved.distance_m > 0.0 &&
+                                !grain.touches(moved.point, moved.normal,
+                                               winding(moved.point + offset * moved.normal) >= 0.5, !gaps.free_space_inside);
   if (beyond) *beyond = std::move(moved.beyond);
   out.moved_m = moved.distance_m;
   out.moved_most_at = moved.point;
@@ -336,8 +344,8 @@ constexpr int survey_block_cells = 16;
 // away: the sprocket's open visual mesh at cells of 1 mm, meshed fine everywhere, was 2.3 million
 // triangles, most of its repair's and its field's cost; fine cells also where merged ones cross
 // each other. Nothing where the merged surface is empty, open, or still moved beyond a cell or
-// crossing once fine cells stop helping (the planetary gear set: gears fused across a gap
-// narrower than a cell, which no cell size here undoes).
+// crossing once fine cells stop helping (the planetary gear set as a cavity: die walls between
+// its gears thinner than a cell, which no cell size here keeps).
 std::optional<WindingSolid> merged_where_flat(const openvdb::FloatGrid& grid, const TriMesh& soup,
                                               const ExactSurface& surface, const WindingNumber& winding, double cell_m,
                                               const ClosableGaps& gaps) {
