@@ -47,7 +47,7 @@ struct WindingSolid {
 // for a tool) a re-mesh may close where no grain of diameter `closable_m` touches the surface.
 struct ClosableGaps {
   double closable_m = 0.0;
-  bool free_space_inside = false;
+  bool free_space_inside = true;
 };
 
 // The region of `soup` with winding number ≥ ½, meshed on cells of `cell_m` (OpenVDB: the

@@ -39,8 +39,9 @@ const SharedDie shared_dies[] = {
     // surface 0.77 mm, more than the tolerance). As a cavity they are die walls, and it is refused
     // (README, "Shared dies through the pipeline").
     {"planetary_gearset_vtk_gears.stl", mesh::LengthUnit::mm, nullptr, 0.714},
-    // 100 overlapping shells: 24·10⁹ winding-number terms at cells of 0.125 mm; at voxels of 0.9 mm
-    // its winding-number solid (138 s) moves the surface 1.76 mm, and it is refused.
+    // 100 overlapping shells: 24·10⁹ winding-number terms at cells of 0.125 mm, and it is refused.
+    // At voxels of 0.9 mm it loads as a tool (472 s) and is refused as a cavity (README, "Shared
+    // dies through the pipeline").
     {"toothed_pulley_hub_trimesh_cycloidal.ply", mesh::LengthUnit::in, "non-manifold edges"},
     // 24 crossing shells: as a tool its winding-number solid closes the gaps between them that
     // no grain a voxel across touches, and it loads (as a cavity it has no flat opening).
