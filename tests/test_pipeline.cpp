@@ -1,7 +1,9 @@
 // The die-filling pipeline end to end on the bundled ring and disc, with 1.6 mm grains (coarse
 // graining 16: about 2500 grains) so that a run takes seconds: every grain counted, the fill
 // ratio against the shoe's speed, the ring's mirror symmetry, identical reports from the same
-// seed, the settled shoe reused across speeds.
+// seed, the settled shoe reused across speeds. The cases of suite `Pipeline` share their runs
+// (the ring's and the disc's base fills) through `run`'s memo and run in one process; those of
+// `PipelineOwnRuns` make their own and run each in its own, beside the others (tests/CMakeLists.txt).
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
@@ -366,7 +368,7 @@ TEST(Pipeline, FemHandOffHoldsTheCavitysMassAndCompactsDenserElementsHarder) {
 
 // A sweep over three shoe speeds: one folder per case, the summary table and chart; each case is
 // bit for bit the run `--set motion.speed=...` gives (the same final state and particle file).
-TEST(Pipeline, SweepRunsEachCaseAsItsSingleRun) {
+TEST(PipelineOwnRuns, SweepRunsEachCaseAsItsSingleRun) {
   const fs::path base = suite_out() / "sweep";
   const auto load = [&](const std::vector<std::string>& more) {
     std::vector<std::string> overrides = {"simulation.seed=1", "output.directory=" + base.string(),
@@ -469,11 +471,11 @@ TEST(Pipeline, OutputsReadBackThroughOtherToolsWithTheRightValues) {
 
 // Results do not depend on the thread count: the shoe settled and moved on two threads ends in
 // the very state (every position, velocity and contact history) one thread gives.
-TEST(Pipeline, TwoThreadsGiveTheSameStateAndGrainsAsOne) {
-  const nlohmann::json& one = run("ring", 0.1, 1, "a");
+TEST(PipelineOwnRuns, TwoThreadsGiveTheSameStateAndGrainsAsOne) {
+  const nlohmann::json& one = run("ring", 0.1, 1, "one_thread", coarse + " simulation.threads=1");
   const nlohmann::json& two = run("ring", 0.1, 1, "two_threads", coarse + " simulation.threads=2");
   EXPECT_EQ(one["final_state_sha256"], two["final_state_sha256"]);
-  EXPECT_EQ(read_text(output_of("ring", "a") / "particles.csv"), read_text(output_of("ring", "two_threads") / "particles.csv"));
+  EXPECT_EQ(read_text(output_of("ring", "one_thread") / "particles.csv"), read_text(output_of("ring", "two_threads") / "particles.csv"));
 }
 
 // docs/PHYSICS.md §3: below the critical speed the cavity fills to the powder's poured density; above
@@ -482,7 +484,7 @@ TEST(Pipeline, TwoThreadsGiveTheSameStateAndGrainsAsOne) {
 // of the disc's fill at this size, 0.09 with 1.6 mm grains, which would put a slow shoe's fill
 // below the poured density's range for a reason that is not the shoe (measured: 0.479 at 1.6 mm).
 // A 6 mm powder bed holds about 1.5 times what the disc takes.
-TEST(Pipeline, FillRatioFallsWithShoeSpeedFromThePouredDensity) {
+TEST(PipelineOwnRuns, FillRatioFallsWithShoeSpeedFromThePouredDensity) {
   const std::string finer = "powder.coarse_graining=12 shoe.fill_height=0.006";
   const double speeds[] = {0.05, 0.25, 0.7};
   double previous = 1;
@@ -517,7 +519,7 @@ TEST(Pipeline, TrimmedShoeFillsLikeTheFullShoe) {
 // Capsule grains as rigid clumps: poured through the shoe into the ring they stay in the die,
 // every grain is counted once, and the binned volume is the grains' true volume (not the sum of
 // their overlapping members').
-TEST(Pipeline, ClumpGrainsFillTheRingWithoutLeaking) {
+TEST(PipelineOwnRuns, ClumpGrainsFillTheRingWithoutLeaking) {
   REQUIRE_SHARED_MESHES();
   const std::string capsule = (test::shared_meshes() / "grains" / "capsule_trimesh.obj").string();
   const nlohmann::json& r =
@@ -535,7 +537,7 @@ TEST(Pipeline, ClumpGrainsFillTheRingWithoutLeaking) {
 // flat top face, so it is no die cavity. Told that its opening faces +z, it goes through the
 // repair to that message; left to find its opening, it is refused as it is read, as having no
 // flat face at any extreme.
-TEST(Pipeline, MeshThatCrashedCorefinementIsRefusedClearly) {
+TEST(PipelineOwnRuns, MeshThatCrashedCorefinementIsRefusedClearly) {
   REQUIRE_SHARED_MESHES();
   for (const auto& [up, message] : {std::pair{"+z", "no flat top face"}, std::pair{"auto", "no flat face at its extreme"}}) {
     app::PipelineScene scene = app::load_pipeline_scene(
@@ -567,7 +569,7 @@ TEST(Pipeline, ShoeFromAMeshFillsLikeTheBox) {
 // Ctrl-C during the fill keeps a checkpoint; `run --resume` finishes from it with the same
 // result as an uninterrupted run, bit for bit: the same report (timings aside), final state and
 // grains.
-TEST(Pipeline, InterruptedRunResumesToTheSameResult) {
+TEST(PipelineOwnRuns, InterruptedRunResumesToTheSameResult) {
   test::TempDir dir;
   const std::string args = "run " + bundled_die("ring").string() + " --out " + dir.path().string() + " --set " + coarse;
   const test::Run whole = test::run_diefill(args);
@@ -601,7 +603,7 @@ TEST(Pipeline, InterruptedRunResumesToTheSameResult) {
 // the shoe's wall and lets them go at the shoe's speed when it stops, and a sphere held back by
 // rolling friction alone (μ_r = 0.1) rolls on for about ten centimetres: such grains may leave over the
 // table's end. They are counted (a leak through the die would have failed the run).
-TEST(Pipeline, MorePassesFillAFastShoesDieFurther) {
+TEST(PipelineOwnRuns, MorePassesFillAFastShoesDieFurther) {
   const double once = run("disc", 0.4, 1, "passes")["fill"]["fill_ratio"].get<double>();
   const nlohmann::json& r = run("disc", 0.4, 1, "passes", coarse + " motion.passes=2 motion.return=true");
   const double twice = r["fill"]["fill_ratio"].get<double>();
@@ -615,7 +617,7 @@ TEST(Pipeline, MorePassesFillAFastShoesDieFurther) {
 
 // A folder run takes the mesh files only: a README or a log beside the dies is passed over, not
 // refused as a broken mesh.
-TEST(Pipeline, FolderRunPassesOverFilesThatAreNotMeshes) {
+TEST(PipelineOwnRuns, FolderRunPassesOverFilesThatAreNotMeshes) {
   test::TempDir dir;
   fs::create_directories(dir / "dies");
   fs::copy_file(bundled_die("ring"), dir / "dies" / "ring.stl");
@@ -632,7 +634,7 @@ TEST(Pipeline, FolderRunPassesOverFilesThatAreNotMeshes) {
 
 // The shoe holds the bed it is asked for: random insertion jams near a third of the volume, so a
 // bed of 18.5 mm needs more than one round (it delivered 82 % of its grains, silently).
-TEST(Pipeline, ShoeIsFilledToTheBedHeightAsked) {
+TEST(PipelineOwnRuns, ShoeIsFilledToTheBedHeightAsked) {
   const nlohmann::json& r = run("ring", 0.4, 1, "deep_bed", coarse + " shoe.fill_height=0.0185 motion.die_settle_time=0.01");
   EXPECT_EQ(r["powder"]["grains"], r["powder"]["grains_requested"]) << r["powder"].dump();
   EXPECT_TRUE(r["stability"]["warnings"].empty()) << r["stability"].dump();
@@ -640,7 +642,7 @@ TEST(Pipeline, ShoeIsFilledToTheBedHeightAsked) {
 
 // The settled shoe is settled again when a key that shapes it changes, and reused when only the
 // shoe's motion does.
-TEST(Pipeline, SettledShoeIsRebuiltWhenASettlingKeyChanges) {
+TEST(PipelineOwnRuns, SettledShoeIsRebuiltWhenASettlingKeyChanges) {
   const auto shoes = [] {
     std::size_t n = 0;
     for (const auto& e : fs::directory_iterator(suite_out() / "resettle" / ".cache")) n += e.path().filename().string().starts_with("shoe-");
