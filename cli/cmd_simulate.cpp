@@ -31,6 +31,7 @@ int run_simulate(const SimulateCommand& c) {
   // Under mpirun every rank reads the scene and keeps its share; rank 0 writes the outputs.
   const std::shared_ptr<dem::Exchange> ranks = mpi_exchange();
   const bool root = !ranks || ranks->rank() == 0;
+  const double start_time = scene.state.time;  // where the outputs' cadence starts, resumed or not
   dem::State state = dem::share_of(std::move(scene.state), ranks);
   const fs::path checkpoint = dir / "checkpoint.bin";
   if (c.resume) {
@@ -43,12 +44,18 @@ int run_simulate(const SimulateCommand& c) {
 
   std::unique_ptr<dem::TrajectoryWriter> trajectory;  // rank 0 opens it; should that fail, every rank stops
   dem::run_and_agree(ranks.get(), root, [&] {
-    if (scene.output.trajectory) trajectory = std::make_unique<dem::TrajectoryWriter>(dir / "trajectory.csv");
+    if (scene.output.trajectory) trajectory = std::make_unique<dem::TrajectoryWriter>(dir / "trajectory.csv", c.resume);
   });
-  int snapshot = 0;
+  // A resumed run goes on with the interrupted one's numbering and rows instead of writing over them.
+  std::int64_t snapshot =
+      c.resume && scene.output.snapshot_every > 0
+          ? first_output_after_resume(start_time, scene.output.snapshot_every, state.time, model.dt)
+          : 0;
   LoopOptions loop;
   loop.until = scene.duration;
   loop.checkpoint = checkpoint;
+  loop.resumed = c.resume;
+  loop.output_origin = start_time;
   // Every rank gathers (collective); rank 0 alone holds the trajectory's file.
   if (scene.output.trajectory)
     loop.outputs.push_back({scene.output.trajectory_every, [&](const dem::State& s) {

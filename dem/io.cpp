@@ -116,11 +116,12 @@ void write_particles_csv(const State& s, const fs::path& path) {
   diefill::write_file_atomic(path, out);
 }
 
-TrajectoryWriter::TrajectoryWriter(const fs::path& path) {
+TrajectoryWriter::TrajectoryWriter(const fs::path& path, bool append) {
   if (path.has_parent_path()) fs::create_directories(path.parent_path());
-  file_ = std::fopen(path.c_str(), "w");
+  const bool header = !append || !fs::exists(path);
+  file_ = std::fopen(path.c_str(), append ? "a" : "w");
   if (!file_) throw InputError(path.string(), "", "cannot be written", "Check the output folder");
-  std::fputs("t,id,x,y,z,vx,vy,vz,wx,wy,wz,fx,fy,fz\n", file_);
+  if (header) std::fputs("t,id,x,y,z,vx,vy,vz,wx,wy,wz,fx,fy,fz\n", file_);
 }
 
 TrajectoryWriter::~TrajectoryWriter() {

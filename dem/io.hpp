@@ -22,7 +22,8 @@ void write_particles_csv(const State& state, const std::filesystem::path& path);
 // Appends `t,id,x,y,z,vx,vy,vz,wx,wy,wz,fx,fy,fz` rows.
 class TrajectoryWriter {
  public:
-  explicit TrajectoryWriter(const std::filesystem::path& path);
+  // `append`: a resumed run's rows go after the interrupted run's (the header is there).
+  TrajectoryWriter(const std::filesystem::path& path, bool append);
   ~TrajectoryWriter();
   void write(const State& state);
 

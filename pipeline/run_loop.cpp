@@ -2,7 +2,9 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <csignal>
 
 #include "core/error.hpp"
@@ -38,20 +40,29 @@ void install_interrupt_handler() {
 
 bool stop_requested() { return g_interrupted; }
 
+std::int64_t first_output_after_resume(double origin, double every, double time, double dt) {
+  // Due by time - dt with the loop's half-step margin: origin + n·every - dt/2 <= time - dt.
+  return std::max<std::int64_t>(0, std::int64_t(std::floor((time - 0.5 * dt - origin) / every)) + 1);
+}
+
 LoopResult run_until(const dem::Model& model, dem::State& s, const LoopOptions& o) {
   LoopResult result;
   diefill::Stopwatch clock;
   diefill::Progress progress(o.label, o.until);
   const double start = s.time;
-  std::vector<double> next_output(o.outputs.size(), s.time);
+  const double origin = o.output_origin.value_or(s.time);
+  std::vector<std::int64_t> next_output(o.outputs.size(), 0);  // of each cadence (Periodic)
+  if (o.resumed)
+    for (std::size_t k = 0; k < o.outputs.size(); ++k)
+      next_output[k] = first_output_after_resume(origin, o.outputs[k].every, s.time, model.dt);
   const std::int64_t grains = s.exchange ? s.exchange->sum(std::int64_t(s.owned())) : std::int64_t(s.size());
   if (!o.resumed) s.loop_max_overlap_rel = s.loop_max_energy_gain = 0;
   while (s.time < o.until - 0.5 * model.dt) {
     bool output = false;
     for (std::size_t k = 0; k < o.outputs.size(); ++k)
-      if (s.time >= next_output[k] - 0.5 * model.dt) {
+      if (s.time >= origin + double(next_output[k]) * o.outputs[k].every - 0.5 * model.dt) {
         o.outputs[k].action(s);
-        next_output[k] += o.outputs[k].every;
+        ++next_output[k];
         output = true;
       }
     if (output && o.finished && o.finished(s)) {

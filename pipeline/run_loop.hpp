@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,8 @@
 namespace app {
 
 // An output at its own cadence: at the start, every `every` seconds of simulated time, and at the end.
+// Output n falls due at the loop's output origin + n·every and is written at the first step that
+// reaches it (less half a step), so that a resumed loop writes what the uninterrupted one would.
 struct Periodic {
   double every = 0;  // [s]
   std::function<void(const dem::State&)> action;
@@ -29,9 +32,17 @@ struct LoopOptions {
   std::function<bool(const dem::State&)> finished;
   // Extra words for the progress line (grains in the cavity, ...).
   std::function<std::string(const dem::State&)> detail;
-  // The state comes from this loop's checkpoint: its maxima so far carry on (LoopResult).
+  // The state comes from this loop's checkpoint: its maxima so far carry on (LoopResult), and
+  // its outputs from the first the interrupted loop had not reached (first_output_after_resume).
   bool resumed = false;
+  // Where the outputs' cadence starts (Periodic); a resumed loop passes the interrupted one's
+  // start. Unset: the state's time when the loop starts.
+  std::optional<double> output_origin;
 };
+
+// The first output of a cadence (`every` from `origin`) that a loop resumed at `time` has still
+// to write: the interrupted loop wrote those due by its last step's start, time - dt.
+std::int64_t first_output_after_resume(double origin, double every, double time, double dt);
 
 struct LoopResult {
   std::int64_t steps = 0;

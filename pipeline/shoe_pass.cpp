@@ -2,7 +2,11 @@
 
 #include <fmt/core.h>
 
+#include <fstream>
+#include <nlohmann/json.hpp>
+
 #include "core/atomic_file.hpp"
+#include "core/error.hpp"
 #include "core/log.hpp"
 #include "dem/checkpoint.hpp"
 #include "dem/distributed.hpp"
@@ -38,6 +42,40 @@ void write_series(const mesh::TriMesh& die_solid, const std::vector<double>& tim
   diefill::write_file_atomic(dir / "series.pvd", pvd);
 }
 
+// What the outputs of an interrupted fill wrote before its checkpoint (beside it, as
+// checkpoint_outputs.json): the cadence's origin, the fill curve's samples and the snapshots'
+// times, so that the resumed run's fill curve and series are the uninterrupted run's.
+struct OutputsSoFar {
+  double origin = 0;  // [s]
+  std::vector<FillSample> curve;
+  std::vector<double> snapshot_times;  // [s]
+};
+
+fs::path outputs_file(const fs::path& checkpoint) { return checkpoint.parent_path() / "checkpoint_outputs.json"; }
+
+void save_outputs(const OutputsSoFar& o, const fs::path& checkpoint) {
+  nlohmann::json curve = nlohmann::json::array();
+  for (const FillSample& p : o.curve) curve.push_back({p.time, p.shoe_x, p.grains, p.mass});
+  const nlohmann::json j = {{"origin_s", o.origin}, {"fill_curve", curve}, {"snapshot_times_s", o.snapshot_times}};
+  diefill::write_file_atomic(outputs_file(checkpoint), j.dump() + "\n");
+}
+
+// A checkpoint without that file beside it (deleted) resumes with the outputs from the
+// resumption on; said so.
+OutputsSoFar load_outputs(const fs::path& checkpoint, double origin) {
+  const fs::path file = outputs_file(checkpoint);
+  if (!fs::exists(file)) {
+    diefill::log::warn("{}: not found: the fill curve and the snapshot series start where the run resumes", file.string());
+    return {origin, {}, {}};
+  }
+  std::ifstream in(file);
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  if (j.is_discarded()) throw diefill::InputError(file.string(), "", "is not the JSON a checkpoint leaves", "Delete it to resume without the outputs before the interrupt");
+  OutputsSoFar o{j.at("origin_s").get<double>(), {}, j.at("snapshot_times_s").get<std::vector<double>>()};
+  for (const auto& p : j.at("fill_curve")) o.curve.push_back({p[0].get<double>(), p[1].get<double>(), p[2].get<std::int64_t>(), p[3].get<double>()});
+  return o;
+}
+
 }  // namespace
 
 std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& walls, const ShoePlan& shoe, double table_z,
@@ -52,19 +90,23 @@ std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& wal
   // Split over ranks, rank 0 looks for the checkpoint and every rank goes by what it saw.
   const bool found = state.exchange ? state.exchange->max(state.exchange->rank() == 0 && fs::exists(checkpoint) ? 1.0 : 0.0) > 0
                                     : fs::exists(checkpoint);
+  OutputsSoFar so_far{state.time, {}, {}};
   if (resume && found) {
+    so_far = load_outputs(checkpoint, state.time);
     state = dem::read_checkpoint(model, checkpoint, state.exchange);
     diefill::log::info("{}: resumed at t = {:.6g} s", walls.die.name, state.time);
   } else {
     dem::initialize(model, state);
   }
+  fill.curve = std::move(so_far.curve);
+  std::vector<double>& snapshot_times = so_far.snapshot_times;
   const mesh::TriMesh shoe_surface = surface_of(*walls.shoe_field);
   LoopOptions loop;
   loop.until = shoe.t_motion + s.die_settle_time;
   loop.label = walls.die.name + ": filling";
   loop.checkpoint = checkpoint;
   loop.resumed = resume && found;
-  std::vector<double> snapshot_times;
+  loop.output_origin = so_far.origin;
   if (s.snapshot_every > 0)
     loop.outputs.push_back({s.snapshot_every, [&](const dem::State& st) {
                               const std::size_t k = snapshot_times.size();
@@ -82,10 +124,22 @@ std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& wal
     for (std::size_t b = 0; b < st.bodies.size(); ++b) n += st.bodies.active[b] && st.bodies.x[b].z() < table_z;
     return fmt::format("{} grains in the cavity", st.exchange ? std::size_t(st.exchange->sum(std::int64_t(n))) : n);
   };
-  fill.loop = run_until(model, state, loop);
-  if (fill.loop.interrupted) return std::nullopt;
+  const auto keep_outputs = [&] {
+    so_far.curve = fill.curve;
+    if (dem::writes_outputs(state)) save_outputs(so_far, checkpoint);
+  };
+  try {
+    fill.loop = run_until(model, state, loop);
+  } catch (const diefill::StabilityError&) {
+    keep_outputs();
+    throw;
+  }
+  if (fill.loop.interrupted) {
+    keep_outputs();
+    return std::nullopt;
+  }
   if (!snapshot_times.empty() && dem::writes_outputs(state)) write_series(walls.die.solid, snapshot_times, dir);
-  if (dem::writes_outputs(state)) fs::remove(checkpoint);
+  if (dem::writes_outputs(state)) fs::remove(checkpoint), fs::remove(outputs_file(checkpoint));
   // The outputs are written from the whole state, on rank 0 of a split run.
   if (state.exchange) state = dem::gathered(state);
   return fill;

@@ -15,7 +15,7 @@ struct FillResult {
   dem::State state;  // split over ranks: the whole state on rank 0, none elsewhere
   LoopResult loop;
   double dt = 0;  // [s]
-  std::vector<FillSample> curve;  // from the start of this run of the loop (a resumed run: from its resumption)
+  std::vector<FillSample> curve;  // from the fill's start (a resumed run: the interrupted run's samples, then its own)
 };
 
 // nullopt when Ctrl-C stopped it (a checkpoint is in `dir`); StabilityError when a check did.

@@ -4,13 +4,17 @@
 
 #include <fmt/core.h>
 
+#include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "mesh/import.hpp"
 #include "mesh/shapes.hpp"
 #include "meshes.hpp"
 #include "support.hpp"
+
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -95,13 +99,13 @@ TEST(Cli, FailedSdfKeepsTheEarlierOutput) {
 
 namespace {
 // A small scene: 200 grains above a floor, written into `dir`.
-void write_scene(const test::TempDir& dir, const std::string& extra_simulation = "") {
+void write_scene(const test::TempDir& dir, const std::string& extra_simulation = "", double duration = 0.01) {
   std::string csv = "id,x,y,z,vx,vy,vz,wx,wy,wz,radius\n";
   for (int n = 0; n < 200; ++n)
     csv += fmt::format("{},{},{},{},0,0,-0.1,0,0,0,5e-4\n", n, (n % 10) * 1.1e-3, (n / 10 % 5) * 1.1e-3,
                        (n / 50) * 1.1e-3 + 1e-3);
   test::write_text(dir / "particles.csv", csv);
-  test::write_text(dir / "scene.toml", "[simulation]\nduration = 0.01\n" + extra_simulation +
+  test::write_text(dir / "scene.toml", fmt::format("[simulation]\nduration = {}\n", duration) + extra_simulation +
                                            "\n[[materials]]\nname = \"glass\"\nyoungs_modulus = 5e6\n"
                                            "\n[particles]\nfile = \"particles.csv\"\n"
                                            "\n[[walls]]\ntype = \"plane\"\nnormal = [0.0, 0.0, 1.0]\n"
@@ -120,6 +124,35 @@ TEST(CliSimulate, WritesTheFilesOfTheInterface) {
   for (const char* array : {"\"id\"", "\"radius\"", "\"velocity\"", "\"angular_velocity\"", "\"force\"", "\"body\""})
     EXPECT_NE(vtu.find(array), std::string::npos) << array;
   EXPECT_NE(test::read_text(dir / "out" / "summary.json").find("particle_steps_per_s"), std::string::npos);
+}
+
+// Ctrl-C halfway, then `--resume`: the outputs are the uninterrupted run's, byte for byte (the
+// trajectory's rows before the interrupt kept, the snapshots numbered on, none written over).
+TEST(CliSimulate, AResumedRunWritesTheUninterruptedRunsOutputs) {
+  test::TempDir dir;
+  write_scene(dir, "", 0.5);
+  const std::string scene = (dir / "scene.toml").string();
+  const auto started = std::chrono::steady_clock::now();
+  ASSERT_EQ(test::run_diefill("simulate " + scene + " --out " + (dir / "whole").string()).status, 0);
+  const double whole_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  // Stopped at half the uninterrupted run's time, whatever this build's speed.
+  const std::string interrupt = fmt::format("bash -c '{} simulate {} --out {} > /dev/null 2>&1 & pid=$!; sleep {:.3f}; "
+                                            "kill -INT $pid; wait $pid; echo $? > {}'",
+                                            DIEFILL_EXECUTABLE, scene, (dir / "part").string(), 0.5 * whole_s,
+                                            (dir / "status").string());
+  ASSERT_EQ(std::system(interrupt.c_str()), 0);
+  ASSERT_EQ(test::read_text(dir / "status"), "130\n");
+  ASSERT_TRUE(fs::exists(dir / "part" / "checkpoint.bin"));
+  const test::Run resumed = test::run_diefill("simulate " + scene + " --out " + (dir / "part").string() + " --resume");
+  ASSERT_EQ(resumed.status, 0) << resumed.output;
+  std::size_t compared = 0;
+  for (const auto& f : fs::directory_iterator(dir / "whole")) {
+    const std::string name = f.path().filename().string();
+    if (name == "summary.json") continue;  // timings
+    EXPECT_TRUE(fs::exists(dir / "part" / name) && test::read_text(dir / "part" / name) == test::read_text(f.path())) << name;
+    ++compared;
+  }
+  EXPECT_EQ(compared, 2u + 101u);  // particles.csv, trajectory.csv and the snapshots at 0, 0.005, ..., 0.5 s
 }
 
 TEST(CliSimulate, UnknownKeysAndBadValuesNameFileAndLine) {

@@ -568,14 +568,27 @@ TEST(Pipeline, ShoeFromAMeshFillsLikeTheBox) {
 
 // Ctrl-C during the fill keeps a checkpoint; `run --resume` finishes from it with the same
 // result as an uninterrupted run, bit for bit: the same report (timings aside), final state and
-// grains.
+// grains, and the same fill curve and snapshot series, the parts written before the interrupt
+// included (none written over by the resumed run).
 TEST(PipelineOwnRuns, InterruptedRunResumesToTheSameResult) {
   test::TempDir dir;
-  const std::string args = "run " + bundled_die("ring").string() + " --out " + dir.path().string() + " --set " + coarse;
+  const std::string args = "run " + bundled_die("ring").string() + " --out " + dir.path().string() + " --set " + coarse +
+                           " --set output.snapshot_every=0.05";
   const test::Run whole = test::run_diefill(args);
   ASSERT_EQ(whole.status, 0) << whole.output;
   nlohmann::json expected = nlohmann::json::parse(test::read_text(dir / "ring" / "report.json"));
   const std::string expected_grains = test::read_text(dir / "ring" / "particles.csv");
+  const auto series = [&] {  // the fill curve, series.pvd and every snapshot of grains and shoe, by name
+    std::map<std::string, std::string> files;
+    for (const auto& f : fs::directory_iterator(dir / "ring")) {
+      const std::string name = f.path().filename().string();
+      if (name == "fill_curve.csv" || name == "series.pvd" || name.starts_with("snapshot_") || name.starts_with("shoe_"))
+        files[name] = test::read_text(f.path());
+    }
+    return files;
+  };
+  const std::map<std::string, std::string> expected_series = series();
+  ASSERT_GT(expected_series.size(), 10u);
   // The die and the settled shoe are cached now: the fill starts within a second or two, and
   // lasts over ten.
   const fs::path status = dir / "status";
@@ -595,6 +608,10 @@ TEST(PipelineOwnRuns, InterruptedRunResumesToTheSameResult) {
   EXPECT_EQ(got.dump(), expected.dump());
   EXPECT_EQ(got["final_state_sha256"], expected["final_state_sha256"]);
   EXPECT_EQ(test::read_text(dir / "ring" / "particles.csv"), expected_grains);
+  const std::map<std::string, std::string> got_series = series();
+  EXPECT_EQ(got_series.size(), expected_series.size());
+  for (const auto& [name, text] : expected_series) EXPECT_TRUE(got_series.contains(name) && got_series.at(name) == text) << name;
+  EXPECT_FALSE(fs::exists(dir / "ring" / "checkpoint_outputs.json")) << "a finished run removes it with the checkpoint";
 }
 
 // Above the critical speed one pass leaves the die short; going back and forth gives the powder
