@@ -16,6 +16,8 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <mutex>
+#include <tuple>
 #include <unordered_map>
 
 #include "core/log.hpp"
@@ -219,7 +221,11 @@ WindingSolid on_input(TriMesh zero, const TriMesh& soup, const ExactSurface& sur
   // could tell (README, "Mesh repair").
   const double offset = 0.25 * cell_m;
   const GrainProbe grain{winding, surface, 0.5 * gaps.closable_m};
-  std::unique_ptr<ExactSurface> result;  // built on the first sample that needs it
+  // The samples are asked on every core (farthest_sample): the result's exact surface is built
+  // once, by the first sample that needs it, and the gap faces are taken in a fixed order after.
+  std::unique_ptr<ExactSurface> result;
+  std::once_flag result_built;
+  std::mutex gap_faces_mutex;
   std::vector<Vec3> gap_faces;
   FarthestSample moved = farthest_sample(
       soup, zero,
@@ -227,12 +233,15 @@ WindingSolid on_input(TriMesh zero, const TriMesh& soup, const ExactSurface& sur
         const bool solid_ahead = winding(p + offset * normal) >= 0.5;
         if (solid_ahead == (winding(p - offset * normal) >= 0.5)) return false;
         if (grain.radius_m <= 0.0 || grain.touches(p, normal, solid_ahead, gaps.free_space_inside)) return true;
-        if (!result) result = std::make_unique<ExactSurface>(zero);
+        std::call_once(result_built, [&] { result = std::make_unique<ExactSurface>(zero); });
         if (result->inside(p) == gaps.free_space_inside) return true;  // the result keeps the free space
+        const std::lock_guard<std::mutex> lock(gap_faces_mutex);
         gap_faces.push_back(p);
         return false;
       },
       beyond ? cell_m : std::numeric_limits<double>::infinity());
+  std::sort(gap_faces.begin(), gap_faces.end(),
+            [](const Vec3& a, const Vec3& b) { return std::tie(a.x(), a.y(), a.z()) < std::tie(b.x(), b.y(), b.z()); });
   for (const Vec3& p : gap_faces) {
     const double depth = result->distance(p);
     if (depth > out.gap_closed_m) out.gap_closed_m = depth, out.gap_closed_at = p;
