@@ -68,12 +68,17 @@ OutputsSoFar load_outputs(const fs::path& checkpoint, double origin) {
     diefill::log::warn("{}: not found: the fill curve and the snapshot series start where the run resumes", file.string());
     return {origin, {}, {}};
   }
-  std::ifstream in(file);
-  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
-  if (j.is_discarded()) throw diefill::InputError(file.string(), "", "is not the JSON a checkpoint leaves", "Delete it to resume without the outputs before the interrupt");
-  OutputsSoFar o{j.at("origin_s").get<double>(), {}, j.at("snapshot_times_s").get<std::vector<double>>()};
-  for (const auto& p : j.at("fill_curve")) o.curve.push_back({p[0].get<double>(), p[1].get<double>(), p[2].get<std::int64_t>(), p[3].get<double>()});
-  return o;
+  try {
+    std::ifstream in(file);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    OutputsSoFar o{j.at("origin_s").get<double>(), {}, j.at("snapshot_times_s").get<std::vector<double>>()};
+    for (const auto& p : j.at("fill_curve"))
+      o.curve.push_back({p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<std::int64_t>(), p.at(3).get<double>()});
+    return o;
+  } catch (const nlohmann::json::exception& e) {
+    throw diefill::InputError(file.string(), "", fmt::format("is not what an interrupted run leaves ({})", e.what()),
+                              "Delete it to resume without the outputs written before the interrupt");
+  }
 }
 
 }  // namespace
