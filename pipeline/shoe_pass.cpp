@@ -53,10 +53,11 @@ struct OutputsSoFar {
 
 fs::path outputs_file(const fs::path& checkpoint) { return checkpoint.parent_path() / "checkpoint_outputs.json"; }
 
-void save_outputs(const OutputsSoFar& o, const fs::path& checkpoint) {
+void save_outputs(double origin, const std::vector<FillSample>& fill_curve, const std::vector<double>& snapshot_times,
+                  const fs::path& checkpoint) {
   nlohmann::json curve = nlohmann::json::array();
-  for (const FillSample& p : o.curve) curve.push_back({p.time, p.shoe_x, p.grains, p.mass});
-  const nlohmann::json j = {{"origin_s", o.origin}, {"fill_curve", curve}, {"snapshot_times_s", o.snapshot_times}};
+  for (const FillSample& p : fill_curve) curve.push_back({p.time, p.shoe_x, p.grains, p.mass});
+  const nlohmann::json j = {{"origin_s", origin}, {"fill_curve", curve}, {"snapshot_times_s", snapshot_times}};
   diefill::write_file_atomic(outputs_file(checkpoint), j.dump() + "\n");
 }
 
@@ -130,8 +131,7 @@ std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& wal
     return fmt::format("{} grains in the cavity", st.exchange ? std::size_t(st.exchange->sum(std::int64_t(n))) : n);
   };
   const auto keep_outputs = [&] {
-    so_far.curve = fill.curve;
-    if (dem::writes_outputs(state)) save_outputs(so_far, checkpoint);
+    if (dem::writes_outputs(state)) save_outputs(so_far.origin, fill.curve, snapshot_times, checkpoint);
   };
   try {
     fill.loop = run_until(model, state, loop);
