@@ -6,6 +6,7 @@
 #include "mesh/repair.hpp"
 #include "mesh/shapes.hpp"
 #include "mesh/tool.hpp"
+#include "mesh/weld.hpp"
 #include "meshes.hpp"
 
 using mesh::Vec3;
@@ -124,6 +125,45 @@ TEST(Repair, UnitesIntersectingShellsExactly) {
   EXPECT_EQ(r.after.shells, 1u);
   EXPECT_NEAR(r.after.volume_m3, (1000.0 + 1000.0 - 125.0) * 1e-9, 1e-15);
   EXPECT_FALSE(r.wrapped);
+}
+
+// A 10 mm cube whose top front edge runs A -> P -> Q -> B with Q 2 µm behind P, as where the two
+// ends of a CAD profile miss each other at a seam: the sliver triangles over P-Q fold back over
+// their neighbours, on the top face and on the front one. Welding Q onto P (closer than a tenth of
+// the 0.05 mm tolerance) removes the folds and moves nothing farther than 2 µm.
+TEST(Repair, WeldsAFoldAtASeamMicronsAcross) {
+  const double fold = 2e-6;
+  mesh::TriMesh cube;
+  cube.vertices = {Vec3(0, 0, 0),        Vec3(10e-3, 0, 0),     Vec3(10e-3, 10e-3, 0),     Vec3(0, 10e-3, 0),
+                   Vec3(0, 0, 10e-3),    Vec3(10e-3, 0, 10e-3), Vec3(10e-3, 10e-3, 10e-3), Vec3(0, 10e-3, 10e-3),
+                   Vec3(5e-3 + fold / 2, 0, 10e-3), Vec3(5e-3 - fold / 2, 0, 10e-3)};
+  enum { Ab, Bb, Cb, Db, A, B, C, D, P, Q };
+  cube.triangles = {{Ab, Cb, Bb}, {Ab, Db, Cb},                           // bottom
+                    {Db, C, Cb},  {Db, D, C},   {Ab, D, Db}, {Ab, A, D},  // back, left
+                    {Bb, Cb, C},  {Bb, C, B},                             // right
+                    {A, P, D},    {P, Q, D},    {Q, B, C},   {Q, C, D},   // top, folded over P-Q
+                    {Ab, P, A},   {Ab, Q, P},   {Ab, Bb, Q}, {Q, Bb, B}}; // front, folded over P-Q
+  const mesh::RepairResult r = mesh::repair(cube, options_mm(), "seam.stl");
+  EXPECT_GT(r.before.self_intersections, 0u);
+  EXPECT_TRUE(r.after.closed);
+  EXPECT_EQ(r.after.self_intersections, 0u);
+  ASSERT_FALSE(r.actions.empty());
+  EXPECT_NE(r.actions.front().find("welded 1 vertices"), std::string::npos) << r.actions.front();
+  EXPECT_NEAR(r.hausdorff_m, fold, 1e-12) << "Q moved onto P, no farther";
+  EXPECT_NEAR(r.after.volume_m3, 1e-6, 1e-15);
+}
+
+// Welding takes each vertex onto the first one closer than the weld distance, never along a
+// chain: of three points 0.6 of it apart in a row, the middle one moves and the last stays.
+TEST(Weld, MovesAVertexNoFartherThanTheWeldDistance) {
+  const double d = 1e-6;
+  const mesh::TriMesh row{{Vec3(0, 0, 0), Vec3(0.6 * d, 0, 0), Vec3(1.2 * d, 0, 0), Vec3(0, 1e-3, 0)},
+                          {{0, 1, 3}, {1, 2, 3}}};
+  const mesh::WeldedMesh w = mesh::weld_close_vertices(row, d);
+  EXPECT_EQ(w.merged, 1u);
+  EXPECT_DOUBLE_EQ(w.moved_m, 0.6 * d);
+  ASSERT_EQ(w.mesh.triangles.size(), 1u) << "the triangle left with a repeated corner is dropped";
+  EXPECT_EQ(w.mesh.triangles[0], (mesh::Triangle{0, 2, 3}));
 }
 
 TEST(Repair, RefusesWhatItCannotRepairWithinTolerance) {
