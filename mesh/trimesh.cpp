@@ -22,6 +22,35 @@ double signed_volume(const TriMesh& mesh) {
   return six_volume / 6.0;
 }
 
+std::vector<TriMesh> separate_bodies(const TriMesh& mesh) {
+  // Union-find over vertices, joined through each triangle's corners.
+  std::vector<int> parent(mesh.vertices.size());
+  for (std::size_t v = 0; v < parent.size(); ++v) parent[v] = int(v);
+  const auto root = [&parent](int v) {
+    while (parent[std::size_t(v)] != v) v = parent[std::size_t(v)] = parent[std::size_t(parent[std::size_t(v)])];
+    return v;
+  };
+  for (const Triangle& t : mesh.triangles) {
+    parent[std::size_t(root(t[1]))] = root(t[0]);
+    parent[std::size_t(root(t[2]))] = root(t[0]);
+  }
+  std::vector<int> body_of_root(mesh.vertices.size(), -1), local(mesh.vertices.size(), -1);
+  std::vector<TriMesh> bodies;
+  for (const Triangle& t : mesh.triangles) {
+    int& body = body_of_root[std::size_t(root(t[0]))];
+    if (body < 0) body = int(bodies.size()), bodies.emplace_back();
+    TriMesh& b = bodies[std::size_t(body)];
+    Triangle mapped{};
+    for (int k = 0; k < 3; ++k) {
+      int& index = local[std::size_t(t[std::size_t(k)])];
+      if (index < 0) index = int(b.vertices.size()), b.vertices.push_back(mesh.vertices[std::size_t(t[std::size_t(k)])]);
+      mapped[std::size_t(k)] = index;
+    }
+    b.triangles.push_back(mapped);
+  }
+  return bodies;
+}
+
 std::vector<std::array<double, 4>> plane_section(const TriMesh& mesh, int axis, double at) {
   const int u = axis == 0 ? 1 : 0, v = axis == 2 ? 1 : 2;
   std::vector<std::array<double, 4>> segments;

@@ -34,6 +34,10 @@ Box bounding_box(const TriMesh& mesh);
 // Signed volume by the divergence theorem [m³]: positive for a closed mesh oriented outward.
 double signed_volume(const TriMesh& mesh);
 
+// The pieces of the mesh that share no vertex, each with its own vertices, in the order of their
+// first triangles: the separate bodies of a part (the gears of a gear set).
+std::vector<TriMesh> separate_bodies(const TriMesh& mesh);
+
 // The mesh cut by the plane where coordinate `axis` (0 x, 1 y, 2 z) equals `at`: one segment per
 // triangle crossed, as (u0, v0, u1, v1) in the plane's other two coordinates in order (z: x, y;
 // y: x, z; x: y, z). For drawing a die's outline; a vertex on the plane counts as above it.

@@ -113,6 +113,33 @@ TEST(TetMesh, IsTheSameMeshTwice) {
   ASSERT_EQ(again.nodes, ring_mesh().nodes);
 }
 
+// Two 10 mm cubes 0.1 mm apart, as the planetary gear set's gears where their teeth mesh: each
+// body is meshed alone and the meshes joined, so that the gap between them does not shrink the
+// elements of either (Mesh_3 keeps the protecting balls of the two bodies' edges apart). The
+// joined mesh is exactly the two cubes' own meshes, nodes and elements in that order.
+TEST(TetMesh, SeparateBodiesAreMeshedEachAlone) {
+  const mesh::TriMesh a = mesh::box_solid(Vec3(0, 0, 0), Vec3(10e-3, 10e-3, 10e-3));
+  const mesh::TriMesh b = mesh::box_solid(Vec3(10.1e-3, 0, 0), Vec3(20.1e-3, 10e-3, 10e-3));
+  mesh::TriMesh both = a;
+  for (mesh::Triangle t : b.triangles) {
+    for (int& v : t) v += int(a.vertices.size());
+    both.triangles.push_back(t);
+  }
+  both.vertices.insert(both.vertices.end(), b.vertices.begin(), b.vertices.end());
+  const std::vector<mesh::TriMesh> bodies = mesh::separate_bodies(both);
+  ASSERT_EQ(bodies.size(), 2u);
+  EXPECT_EQ(bodies[1].triangles.size(), b.triangles.size());
+  EXPECT_NEAR(mesh::signed_volume(bodies[1]), 1e-6, 1e-15);
+  const mesh::TetMeshOptions o{4e-3, 2e-5, 60};
+  const mesh::TetMesh alone_a = mesh::tetrahedralise(bodies[0], o, "a"), alone_b = mesh::tetrahedralise(bodies[1], o, "b");
+  const mesh::TetMesh joined = mesh::tetrahedralise(both, o, "both");
+  ASSERT_EQ(joined.tets.size(), alone_a.tets.size() + alone_b.tets.size());
+  ASSERT_EQ(joined.nodes.size(), alone_a.nodes.size() + alone_b.nodes.size());
+  for (std::size_t i = 0; i < alone_b.nodes.size(); ++i)
+    ASSERT_EQ(joined.nodes[alone_a.nodes.size() + i], alone_b.nodes[i]) << i;
+  EXPECT_NEAR(mesh_volume(joined), 2e-6, 1e-12);
+}
+
 TEST(FemFill, KeepsALatticeFlatUpToTheWallsAndConservesItsVolume) {
   // An FCC lattice of 0.2 mm cells (touching spheres, φ = 0.7405) whose centres lie in the ring's
   // cavity, on the ring's 1.6 mm elements averaged over 1.6 mm (as a run averages over its density
