@@ -140,6 +140,31 @@ TEST(TetMesh, SeparateBodiesAreMeshedEachAlone) {
   EXPECT_NEAR(mesh_volume(joined), 2e-6, 1e-12);
 }
 
+// A 10 mm cube whose corner (10, 10, 10) mm is cut off by a chamfer 1 µm across, edges of microns
+// between sharp features as on the planetary gear set's ring gear: those vertices are welded
+// before meshing (they lie within the facet distance), so no element edge is that short. Unwelded,
+// Mesh_3 protects the chamfer's edges and puts nodes on its three corners.
+TEST(TetMesh, EdgesShorterThanTheFacetDistanceShrinkNoElement) {
+  const double d = 1e-6, a = 10e-3;
+  mesh::TriMesh cube;
+  cube.vertices = {Vec3(0, 0, 0), Vec3(a, 0, 0), Vec3(a, a, 0), Vec3(0, a, 0), Vec3(0, 0, a), Vec3(a, 0, a),
+                   Vec3(a - d, a, a), Vec3(a, a - d, a), Vec3(a, a, a - d), Vec3(0, a, a)};
+  enum { O, X, XY, Y, Z, XZ, Gx, Gy, Gz, YZ };
+  // Each face as a polygon counter-clockwise seen from outside, fanned from its first corner.
+  const std::vector<std::vector<int>> faces = {{O, Y, XY, X},  {O, X, XZ, Z},       {O, Z, YZ, Y},  {Z, XZ, Gy, Gx, YZ},
+                                               {X, XY, Gz, Gy, XZ}, {Y, YZ, Gx, Gz, XY}, {Gx, Gy, Gz}};
+  for (const auto& f : faces)
+    for (std::size_t k = 1; k + 1 < f.size(); ++k) cube.triangles.push_back({f[0], f[k], f[k + 1]});
+  ASSERT_NEAR(mesh::signed_volume(cube), a * a * a, 1e-15) << "closed and outward";
+  const mesh::TetMesh m = mesh::tetrahedralise(cube, {4e-3, 2e-5, 60}, "chamfer");
+  double shortest = 1;
+  for (const mesh::Tet& t : m.tets)
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) shortest = std::min(shortest, (m.nodes[t[i]] - m.nodes[t[j]]).norm());
+  EXPECT_GT(shortest, 1e-4);
+  EXPECT_NEAR(mesh_volume(m), a * a * a, 1e-3 * a * a * a);
+}
+
 TEST(FemFill, KeepsALatticeFlatUpToTheWallsAndConservesItsVolume) {
   // An FCC lattice of 0.2 mm cells (touching spheres, φ = 0.7405) whose centres lie in the ring's
   // cavity, on the ring's 1.6 mm elements averaged over 1.6 mm (as a run averages over its density
