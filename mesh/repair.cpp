@@ -112,6 +112,21 @@ TriMesh outward_pieces(SurfaceMesh sm) {
   return out;
 }
 
+// The mesh as the polygon soup CGAL's soup repair takes.
+struct Soup {
+  std::vector<Point> points;
+  std::vector<std::vector<std::size_t>> polygons;
+};
+Soup soup_of(const TriMesh& mesh) {
+  Soup soup;
+  soup.points.reserve(mesh.vertices.size());
+  for (const Vec3& v : mesh.vertices) soup.points.push_back(to_point(v));
+  soup.polygons.reserve(mesh.triangles.size());
+  for (const Triangle& t : mesh.triangles)
+    soup.polygons.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
+  return soup;
+}
+
 SurfaceMesh polygon_mesh_of(const TriMesh& mesh) {
   std::vector<Point> points;
   for (const Vec3& v : mesh.vertices) points.push_back(to_point(v));
@@ -140,11 +155,7 @@ std::optional<SmallFoldsWelded> weld_small_folds(const TriMesh& mesh, double tol
   for (const double share : weld_shares_of_tolerance) {
     const WeldedMesh welded = weld_close_vertices(mesh, share * tolerance_m);
     if (welded.merged == 0) continue;
-    std::vector<Point> points;
-    for (const Vec3& v : welded.mesh.vertices) points.push_back(to_point(v));
-    std::vector<std::vector<std::size_t>> polygons;
-    for (const Triangle& t : welded.mesh.triangles)
-      polygons.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
+    auto [points, polygons] = soup_of(welded.mesh);
     PMP::repair_polygon_soup(points, polygons);
     if (!PMP::orient_polygon_soup(points, polygons)) continue;  // the weld pinched the surface
     SurfaceMesh sm;
@@ -318,13 +329,7 @@ RepairResult repair(const TriMesh& input, const RepairOptions& options, const st
 
   // 1. Soup level: merge duplicate points, drop triangles with repeated vertices, and keep one
   //    of each duplicated triangle (either winding: double-sided surfaces become single).
-  std::vector<Point> points;
-  points.reserve(input.vertices.size());
-  for (const Vec3& v : input.vertices) points.push_back(to_point(v));
-  std::vector<std::vector<std::size_t>> polygons;
-  polygons.reserve(input.triangles.size());
-  for (const Triangle& t : input.triangles)
-    polygons.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
+  auto [points, polygons] = soup_of(input);
   PMP::repair_polygon_soup(points, polygons);
   if (polygons.size() != input.triangles.size())
     result.actions.push_back(fmt::format("removed {} duplicate or repeated-vertex triangles",

@@ -17,6 +17,7 @@
 
 #include "core/child_process.hpp"
 #include "core/error.hpp"
+#include "mesh/repair.hpp"
 #include "mesh/weld.hpp"
 
 namespace mesh {
@@ -64,28 +65,21 @@ bool is_flat_boundary_cell(const C3t3& c3t3, const Cell& c) {
   return boundary_faces >= 2;
 }
 
-// Whether every edge runs once each way: a closed, consistently oriented, manifold surface.
-bool closed_and_manifold(const TriMesh& m) {
-  std::map<std::pair<int, int>, int> runs;
-  for (const Triangle& t : m.triangles)
-    for (int k = 0; k < 3; ++k) ++runs[{t[std::size_t(k)], t[std::size_t((k + 1) % 3)]}];
-  for (const auto& [edge, count] : runs) {
-    const auto back = runs.find({edge.second, edge.first});
-    if (count != 1 || back == runs.end() || back->second != 1) return false;
-  }
-  return true;
-}
-
-// Vertices closer than the facet distance welded, when the body stays one closed surface. An
-// edge that short between sharp features (the planetary gear set's ring gear has edges of 2 µm)
-// makes Mesh_3 protect them with balls that small and refine all around them: alone, the ring
-// gear's mesh had not ended after 2 minutes, a planet's took under 30 s. The mesh's boundary may
-// lie the facet distance from the surface anyway.
+// Vertices closer than the facet distance welded, when the body stays one closed, oriented
+// surface without degenerate faces or crossings (repair's checks). An edge that short between
+// sharp features (the planetary gear set's ring gear has edges of 2 µm) makes Mesh_3 protect
+// them with balls that small and refine all around them: alone, the ring gear's mesh had not
+// ended after 2 minutes, a planet's took under 30 s. The mesh's boundary may lie the facet
+// distance from the surface anyway.
 TriMesh without_edges_shorter_than(const TriMesh& body, double length) {
   const WeldedMesh welded = weld_close_vertices(body, length);
   if (welded.merged == 0) return body;
   std::vector<TriMesh> parts = separate_bodies(welded.mesh);  // also drops the welded vertices
-  if (parts.size() != 1 || !closed_and_manifold(parts.front())) return body;
+  if (parts.size() != 1) return body;
+  const MeshReport welded_report = inspect(parts.front());
+  if (!welded_report.closed || welded_report.inconsistent_edges > 0 || welded_report.degenerate_faces > 0 ||
+      welded_report.self_intersections > 0)
+    return body;
   return std::move(parts.front());
 }
 
