@@ -20,15 +20,18 @@ int run_sdf(const SdfCommand& c) {
   if (c.max_hole_mm) options.repair.max_hole_m = *c.max_hole_mm * mm;
   options.table_margin_m = c.table_margin_mm * mm;
 
-  const mesh::DieFile file =
-      mesh::read_die_file(c.mesh, mesh::parse_unit_or_auto(c.units, "--units"), mesh::up_to_read(options));
+  options.parting = mesh::parse_parting(c.parting, "--parting");
+  const mesh::DieFile file = mesh::read_die_file(c.mesh, mesh::parse_unit_or_auto(c.units, "--units"),
+                                                 mesh::up_to_read(options), mesh::parting_to_read(options));
   options.unit = file.unit;
   const mesh::PreparedDie die = mesh::prepare_die(file, options, std::nullopt);
   fmt::print("mesh {} ({} units{}: {})\n", die.source, mesh::unit_name(options.unit),
              file.unit_guessed ? ", guessed from its size; --units chooses" : "", die.sha256);
   if (die.up != mesh::Up{})
     fmt::print("orientation: the opening faces {} in the file ({}); turned so that it faces +z\n", mesh::up_name(die.up),
-               die.up_found ? "found: the flat extreme face that opens the most of its outline; --up chooses" : "--up");
+               !die.up_found ? "--up"
+               : die.parting_z ? "found: no flat face at any extreme, so laid flat, up along the axis of its largest outline; --up chooses"
+                               : "found: the flat extreme face that opens the most of its outline; --up chooses");
   fmt::print("check:\n{}", mesh::format_report(die.before));
   if (die.actions.empty()) {
     fmt::print("repair: nothing to do\n");

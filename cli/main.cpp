@@ -19,6 +19,10 @@ void add_sdf(CLI::App& root, app::SdfCommand& c, std::function<int()>& action) {
       ->capture_default_str();
   cmd->add_option("--up", c.up, "The way a cavity's opening faces in the file: +x, -x, +y, -y, +z, -z, or auto (found)")
       ->capture_default_str();
+  cmd->add_option("--parting", c.parting,
+                  "Where the table meets a cavity's part: opening (its flat face), widest (its widest section) or auto "
+                  "(die.parting)")
+      ->capture_default_str();
   cmd->add_option("--role", c.role, "cavity (the part, open at the table), tool (the die body) or container (a closed vessel)")
       ->capture_default_str();
   cmd->add_option("--grain-radius", c.grain_radius_mm, "Largest grain radius [mm]")->capture_default_str();

@@ -63,4 +63,9 @@ struct UnionResult {
 // removed, or a union step fails; then `out` is unspecified.
 bool union_of_shells(const TriMesh& closed_shells, UnionResult& out);
 
+// The part of a closed, outward solid that crossing nowhere lies below the plane z = `height`,
+// closed by its section there (CGAL's clip of the volume, which corefines: hence here). False
+// when the result is not a closed manifold surface or is empty; then `out` is unspecified.
+bool clip_below(const TriMesh& closed, double height, TriMesh& out);
+
 }  // namespace mesh::detail

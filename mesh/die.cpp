@@ -11,6 +11,7 @@
 #include "core/log.hpp"
 #include "core/sha256.hpp"
 #include "core/timer.hpp"
+#include "mesh/cgal_ops.hpp"
 #include "mesh/source_hash.hpp"
 
 namespace mesh {
@@ -103,6 +104,25 @@ void check_options(const DieOptions& o, const std::string& source) {
   positive(o.table_margin_m, "table margin");
 }
 
+// The part below the parting plane becomes the cavity: the table cuts it at its widest section
+// and the upper punch would form the rest (docs/INTERFACE.md, `die.parting`).
+void cut_at_parting_plane(PreparedDie& die, const std::string& source) {
+  const Box whole = bounding_box(die.cavity);
+  const double z = *die.parting_z;
+  TriMesh below;
+  if (!detail::clip_below(die.cavity, z, below))
+    throw InputError(source, "die.parting",
+                     fmt::format("cutting the part at its widest section, z = {:.4g} mm, did not leave a closed solid",
+                                 z * 1e3),
+                     "Give the die's cavity with its flat opening (the part's face on the die table)");
+  die.actions.push_back(fmt::format(
+      "the die table cuts the part at its widest section, {:.4g} mm above its lowest point of its {:.4g} mm height: "
+      "the cavity is the part below, the upper punch would form the rest (die.parting)",
+      (z - whole.lo.z()) * 1e3, whole.size().z() * 1e3));
+  die.cavity = std::move(below);
+  die.after = inspect(die.cavity);
+}
+
 }  // namespace
 
 WallRole parse_role(std::string_view text, std::string_view field) {
@@ -137,20 +157,21 @@ DieOptions die_options_for_grains(double grain_radius_m, double skin_m, std::opt
   return o;
 }
 
-std::string die_cache_key(const std::string& file_sha256, Up up, const DieOptions& o) {
+std::string die_cache_key(const std::string& file_sha256, Up up, std::optional<double> parting_z, const DieOptions& o) {
   std::string text = fmt::format(
       "format={};sha={};unit={};up={};role={};voxel={:.17g};ext={:.17g};int={:.17g};tol={:.17g};"
       "hole={:.17g};gap={:.17g};wrap={};margin={:.17g}",
       cache_format, file_sha256, unit_name(o.unit), up_name(up), role_name(o.role), o.voxel_m, o.exterior_band_m,
       o.interior_band_m, o.repair.tolerance_m, o.repair.max_hole_m, o.repair.closable_gap_m, o.repair.allow_wrap,
       o.table_margin_m);
+  if (parting_z) text += fmt::format(";parting={:.17g}", *parting_z);
   if (o.table)
     text += fmt::format(";table={:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", o.table->x_min,
                         o.table->y_min, o.table->x_max, o.table->y_max, o.table->thickness);
   return diefill::sha256_hex(text);
 }
 
-DieFile read_die_file(const fs::path& path, std::optional<LengthUnit> unit, std::optional<Up> up) {
+DieFile read_die_file(const fs::path& path, std::optional<LengthUnit> unit, std::optional<Up> up, Parting parting) {
   DieFile file;
   file.source = path.string();
   file.name = path.stem().string();
@@ -161,8 +182,11 @@ DieFile read_die_file(const fs::path& path, std::optional<LengthUnit> unit, std:
   file.mesh = std::move(imported.mesh);
   file.sha256 = diefill::sha256_file(path);
   file.up_found = !up;
-  file.up = up ? *up : find_opening(file.mesh, file.source);
+  const bool opens = up ? opening_area(file.mesh, *up) > 0 : has_flat_extreme(file.mesh);
+  const bool cut = parting == Parting::widest || (parting == Parting::automatic && !opens);
+  file.up = up ? *up : (cut && !opens) ? lying_flat(file.mesh) : find_opening(file.mesh, file.source);
   turn_up(file.mesh, file.up);
+  if (cut) file.parting_z = widest_section_z(file.mesh);
   return file;
 }
 
@@ -170,8 +194,12 @@ std::optional<Up> up_to_read(const DieOptions& options) {
   return options.up || options.role == WallRole::cavity ? options.up : Up{};
 }
 
+Parting parting_to_read(const DieOptions& options) {
+  return options.role == WallRole::cavity ? options.parting : Parting::opening;
+}
+
 PreparedDie prepare_die(const fs::path& path, const DieOptions& options, const std::optional<fs::path>& cache_dir) {
-  return prepare_die(read_die_file(path, options.unit, up_to_read(options)), options, cache_dir);
+  return prepare_die(read_die_file(path, options.unit, up_to_read(options), parting_to_read(options)), options, cache_dir);
 }
 
 PreparedDie prepare_die(const DieFile& file, const DieOptions& options, const std::optional<fs::path>& cache_dir) {
@@ -187,9 +215,10 @@ PreparedDie prepare_die(const DieFile& file, const DieOptions& options, const st
   out.sha256 = file.sha256;
   out.up = file.up;
   out.up_found = file.up_found;
+  out.parting_z = options.role == WallRole::cavity ? file.parting_z : std::nullopt;
   out.unit = file.unit;
   out.unit_guessed = file.unit_guessed;
-  out.cache_key = die_cache_key(out.sha256, file.up, options);
+  out.cache_key = die_cache_key(out.sha256, file.up, out.parting_z, options);
 
   if (cache_dir) {
     const fs::path base = *cache_dir / out.cache_key;
@@ -229,6 +258,7 @@ PreparedDie prepare_die(const DieFile& file, const DieOptions& options, const st
   out.hausdorff_m = repaired.hausdorff_m;
   out.bridged_m = repaired.bridged_m;
   out.cavity = std::move(repaired.mesh);
+  if (out.parting_z) cut_at_parting_plane(out, source);
 
   const double extent = out.after.bbox.size().maxCoeff();
   if (extent < 4 * options.voxel_m)

@@ -32,6 +32,8 @@ struct DieOptions {
   WallRole role = WallRole::cavity;
   // The way the opening faces in the file; unset: found (find_opening) for a cavity, +z otherwise.
   std::optional<Up> up;
+  // Where the table meets a cavity's part (docs/INTERFACE.md, `die.parting`).
+  Parting parting = Parting::automatic;
   double voxel_m = 1.25e-4;         // voxel edge [m]
   double exterior_band_m = 1e-3;    // contact range plus neighbour skin plus one voxel [m]
   double interior_band_m = 2.5e-4;  // [m]
@@ -48,6 +50,7 @@ struct PreparedDie {
   bool unit_guessed = false;         // from its size, not given
   Up up;               // the way its opening faced in the file (now +z)
   bool up_found = false;  // found by looking, not given
+  std::optional<double> parting_z;  // [m] where the table cuts a part with no flat opening (DieFile)
   MeshReport before, after;          // checks before and after repair
   std::vector<std::string> actions;  // repair steps taken
   bool wrapped = false;
@@ -71,16 +74,24 @@ struct DieFile {
   bool unit_guessed = false;  // from its size (guess_unit), not given
   Up up;                  // the way its opening faced in the file; the mesh is turned to face +z
   bool up_found = false;  // found by looking, not given
-  TriMesh mesh;        // [m]
+  // [m] turned: the height at which the die table cuts the part (its widest section), where
+  // `parting` asks for it; the part above it is left to the upper punch. Unset: the table lies at
+  // the part's flat top face.
+  std::optional<double> parting_z;
+  TriMesh mesh;        // [m], turned, whole
 };
 // Reads the file in `unit` (unset: guessed from its size, with a warning) and turns it so that
-// its opening faces +z (`up` unset: find_opening). Throws InputError for a missing, empty or
-// unreadable file.
-DieFile read_die_file(const std::filesystem::path& path, std::optional<LengthUnit> unit, std::optional<Up> up = Up{});
+// its opening faces +z (`up` unset: find_opening, or lying_flat for a part with no flat face that
+// `parting` lets be cut). Throws InputError for a missing, empty or unreadable file, and for a
+// part with no flat face when `parting` is Parting::opening.
+DieFile read_die_file(const std::filesystem::path& path, std::optional<LengthUnit> unit, std::optional<Up> up = Up{},
+                      Parting parting = Parting::automatic);
 
 // The `up` to read a die's file with: the options' own, or for a cavity unset (its opening is
 // found); a tool or a container is not turned.
 std::optional<Up> up_to_read(const DieOptions& options);
+// The parting to read it with: the options' own for a cavity; a tool or a container is not cut.
+Parting parting_to_read(const DieOptions& options);
 
 // Throws InputError for every defect of the file or the options (a die smaller than a few
 // voxels, for instance, usually a mesh in metres read as millimetres).
@@ -95,6 +106,6 @@ DieOptions die_options_for_grains(double grain_radius_m, double skin_m,
                                   std::optional<double> voxel_m = std::nullopt);
 
 // The cache key: the file's bytes and every parameter that changes the result.
-std::string die_cache_key(const std::string& file_sha256, Up up, const DieOptions& options);
+std::string die_cache_key(const std::string& file_sha256, Up up, std::optional<double> parting_z, const DieOptions& options);
 
 }  // namespace mesh

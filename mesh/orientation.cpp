@@ -17,6 +17,8 @@ constexpr int shadow_cells = 256;
 // tip, a boss's end face: the shared 8-tooth gear and flanged ring, 3 % and 9 % of theirs); the
 // slot die's 1.2 mm opening is the whole of its outline. The project's choice, README "Dies".
 constexpr double min_top_open_share = 0.5;
+// Levels the widest section is sought among: a section to 1/256 of the part's height.
+constexpr int section_levels = 256;
 }  // namespace
 
 std::optional<Up> parse_up(std::string_view text, std::string_view field) {
@@ -100,9 +102,62 @@ Up find_opening(const TriMesh& mesh, const std::string& source) {
   if (largest == 0)
     throw diefill::InputError(source, "top face",
                               "the cavity has no flat face at its extreme along any axis, so powder cannot enter it",
-                              "Give a cavity with a flat opening (the part's top face), or pass role = \"tool\" if the "
-                              "mesh is the die body");
+                              "Give a cavity with a flat opening (the part's top face), set die.parting = \"auto\" to cut "
+                              "it at its widest section, or pass role = \"tool\" if the mesh is the die body");
   return best;
+}
+
+bool has_flat_extreme(const TriMesh& mesh) {
+  for (int axis = 0; axis < 3; ++axis)
+    for (int sign : {1, -1})
+      if (opening_area(mesh, Up{axis, sign}) > 0) return true;
+  return false;
+}
+
+Up lying_flat(const TriMesh& mesh) {
+  Up best{};
+  double largest = -1;
+  for (int axis = 0; axis < 3; ++axis)
+    if (const double shadow = shadow_area(mesh, axis); shadow > largest * (1 + 1e-9)) largest = shadow, best = Up{axis, 1};
+  return best;
+}
+
+Parting parse_parting(std::string_view text, std::string_view field) {
+  if (text == "auto") return Parting::automatic;
+  if (text == "opening") return Parting::opening;
+  if (text == "widest") return Parting::widest;
+  throw diefill::InputError("", std::string(field), "'" + std::string(text) + "' is not a parting",
+                            "Give opening (the table at the part's flat face), widest (at its widest section) or auto");
+}
+
+double section_area(const TriMesh& mesh, double height) {
+  double twice_area = 0;
+  for (const Triangle& t : mesh.triangles) {
+    const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+    // The crossings of the edges whose ends lie on either side (an end on the plane counts as above).
+    std::array<Vec3, 2> crossing;
+    int found = 0;
+    for (const auto& [p, q] : {std::pair{&a, &b}, std::pair{&b, &c}, std::pair{&c, &a}})
+      if (((*p).z() < height) != ((*q).z() < height) && found < 2) {
+        const double s = (height - p->z()) / (q->z() - p->z());
+        crossing[std::size_t(found++)] = *p + s * (*q - *p);
+      }
+    if (found < 2) continue;
+    const Vec3 along = Vec3::UnitZ().cross((b - a).cross(c - a));
+    if ((crossing[1] - crossing[0]).dot(along) < 0) std::swap(crossing[0], crossing[1]);
+    twice_area += crossing[0].x() * crossing[1].y() - crossing[1].x() * crossing[0].y();
+  }
+  return 0.5 * twice_area;
+}
+
+double widest_section_z(const TriMesh& mesh) {
+  const Box box = bounding_box(mesh);
+  double best_z = box.hi.z(), largest = -1;
+  for (int level = section_levels - 1; level >= 0; --level) {
+    const double z = box.lo.z() + (level + 0.5) / section_levels * box.size().z();
+    if (const double area = section_area(mesh, z); area > largest * (1 + 1e-9)) largest = area, best_z = z;
+  }
+  return best_z;
 }
 
 void turn_up(TriMesh& mesh, Up up) {

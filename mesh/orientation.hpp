@@ -32,6 +32,28 @@ double shadow_area(const TriMesh& mesh, int axis);
 // naming `source` when no axis has one.
 Up find_opening(const TriMesh& mesh, const std::string& source);
 
+// Whether some extreme of the mesh along an axis has a flat face facing out: what find_opening
+// needs.
+bool has_flat_extreme(const TriMesh& mesh);
+
+// +x, +y or +z, whichever the part's shadow is largest along: a part with no flat face lies
+// flat in its die, the shallowest cavity (of two alike, the first).
+Up lying_flat(const TriMesh& mesh);
+
+// Where the die table meets the part (docs/INTERFACE.md, `die.parting`): at its flat opening
+// (refused when it has none), at its widest section along z (the upper punch forms the part
+// above it), or automatically the first when it has a flat opening and else the second.
+enum class Parting { automatic, opening, widest };
+Parting parse_parting(std::string_view text, std::string_view field);
+
+// Area of the section of a closed, outward surface by the plane z = height [m²]: the shoelace
+// sum over the segments where its triangles cross the plane, each taken the way the section's
+// boundary runs counter-clockwise seen from +z (the outward normal's turn about z).
+double section_area(const TriMesh& mesh, double height);
+// The height [m] of the largest section_area among levels spaced evenly through the mesh's
+// height (of several alike, the highest: the most of the part below the table).
+double widest_section_z(const TriMesh& mesh);
+
 // Turns the mesh so that `up` becomes +z (a proper rotation; +z leaves it as it is).
 void turn_up(TriMesh& mesh, Up up);
 

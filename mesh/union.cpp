@@ -1,6 +1,7 @@
-// Exact union of intersecting closed shells by corefinement (CGAL PMP), in its own translation
-// unit: corefinement is the heaviest CGAL header the project uses.
+// Exact union of intersecting closed shells, and the clip of a solid by a plane, by corefinement
+// (CGAL PMP), in their own translation unit: corefinement is the heaviest CGAL header the project uses.
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/clip.h>
 #include <CGAL/Polygon_mesh_processing/connected_components.h>
 #include <CGAL/Polygon_mesh_processing/corefinement.h>
 #include <CGAL/Polygon_mesh_processing/orientation.h>
@@ -152,6 +153,17 @@ bool union_of_shells(const TriMesh& closed_shells, UnionResult& out) {
   in.get(united.mesh.triangles);
   if (!in.ok() || ok != 1) return false;
   out = std::move(united);
+  return true;
+}
+
+bool clip_below(const TriMesh& closed, double height, TriMesh& out) {
+  SurfaceMesh sm;
+  if (!to_surface_mesh(closed, sm) || !CGAL::is_closed(sm)) return false;
+  // The plane's negative side is kept: below z = height.
+  if (!PMP::clip(sm, K::Plane_3(0, 0, 1, -height), CGAL::parameters::clip_volume(true))) return false;
+  sm.collect_garbage();
+  if (sm.is_empty() || !CGAL::is_closed(sm)) return false;
+  out = to_trimesh(sm);
   return true;
 }
 

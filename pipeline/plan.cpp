@@ -33,12 +33,24 @@ DieSource read_die(const PipelineScene& scene, const std::filesystem::path& die_
   if (mesh::parse_role(scene.die_role, "die.role") != mesh::WallRole::cavity)
     throw diefill::InputError(die_mesh.string(), "die.role", "the pipeline fills a cavity", "Give the cavity mesh (role \"cavity\")");
   DieSource die;
-  die.file = mesh::read_die_file(die_mesh, mesh::parse_unit_or_auto(scene.die_units, "die.units"), mesh::parse_up(scene.die_up, "die.up"));
-  if (die.file.up_found && die.file.up != mesh::Up{})
+  die.file = mesh::read_die_file(die_mesh, mesh::parse_unit_or_auto(scene.die_units, "die.units"), mesh::parse_up(scene.die_up, "die.up"),
+                                 mesh::parse_parting(scene.die_parting, "die.parting"));
+  if (die.file.up_found && die.file.up != mesh::Up{} && !die.file.parting_z)
     diefill::log::warn("{}: its opening (a flat face at its extreme) faces {} in the file; turned so that it faces up. "
                        "Set die.up to choose another way",
                        die.file.name, mesh::up_name(die.file.up));
   die.box = mesh::bounding_box(die.file.mesh);
+  if (die.file.parting_z) {
+    diefill::log::warn("{}: it has no flat face the die could open on{}; the die table cuts it at its widest section, "
+                       "{:.4g} mm above its lowest point, and the upper punch would form the part above. Set "
+                       "die.parting = \"opening\" to refuse such a part",
+                       die.file.name,
+                       die.file.up_found ? fmt::format(" (laid flat: up is {} in the file, the axis of its largest outline)",
+                                                       mesh::up_name(die.file.up))
+                                         : "",
+                       (*die.file.parting_z - die.box.lo.z()) * 1e3);
+    die.box.hi.z() = *die.file.parting_z;
+  }
   die.table_z = die.box.hi.z();
   return die;
 }

@@ -61,6 +61,12 @@ KeyTable<P> make_pipeline_keys() {
            "when the flat faces at the top cover half of the part's outline seen from above, else the extreme whose "
            "flat faces cover the largest share of the outline along their axis",
            &P::die_up),
+      text("die", "parting", KeyType::choice, {"auto", "opening", "widest"}, die,
+           "where the die table meets the part: opening, at its flat face (a part with none is refused); widest, at "
+           "its widest section across the up axis, the cavity being the part below (the upper punch forms the "
+           "rest); auto: opening when the part has a flat face at an extreme, else widest with the part lying flat "
+           "(up: the axis of its largest outline)",
+           &P::die_parting),
       text("die", "role", KeyType::choice, {"cavity"}, die,
            "the mesh is the part's shape, open at the die table (its highest z); `diefill sdf --role` takes tools too",
            &P::die_role),

@@ -21,6 +21,15 @@ double polygon_annulus_volume(double ro, double ri, double depth, int n) {
   return 0.5 * n * std::sin(2 * std::numbers::pi / n) * (ro * ro - ri * ri) * depth;
 }
 
+// The octahedron with vertices ±a x, ±b y, ±c z [m], outward: no flat face anywhere.
+mesh::TriMesh octahedron_of(double a, double b, double c) {
+  mesh::TriMesh octahedron;
+  for (const double half : {a, b, c})
+    for (int s : {1, -1}) octahedron.vertices.push_back(s * half * Vec3::Unit(int(octahedron.vertices.size()) / 2));
+  octahedron.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  return octahedron;
+}
+
 }  // namespace
 
 TEST(BundledDies, MeetChordToleranceAndAnalyticVolume) {
@@ -108,10 +117,7 @@ TEST(Orientation, FindsTheOpeningWhicheverWayTheDieFaces) {
   // Every generated die (the 1.2 mm slot's opening is its whole outline, its sides 6.7 times its area).
   for (const std::string& name : mesh::generated_die_names())
     EXPECT_EQ(mesh::find_opening(mesh::bundled_die(name), name), mesh::Up{}) << name;
-  mesh::TriMesh octahedron;
-  for (int a = 0; a < 3; ++a)
-    for (int s : {1, -1}) octahedron.vertices.push_back(s * Vec3::Unit(a) * 1e-2);
-  octahedron.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  const mesh::TriMesh octahedron = octahedron_of(1e-2, 1e-2, 1e-2);
   try {
     mesh::find_opening(octahedron, "octahedron.stl");
     ADD_FAILURE() << "an octahedron has no opening";
@@ -133,6 +139,62 @@ TEST(Orientation, ABossIsNoOpening) {
   const mesh::TriMesh part = test::joined(flange, boss);
   EXPECT_NEAR(mesh::shadow_area(part, 2), std::numbers::pi * 1e-4, 0.01 * std::numbers::pi * 1e-4);
   EXPECT_EQ(mesh::find_opening(part, "flange"), (mesh::Up{2, -1}));
+}
+
+// An octahedron's sections are rhombi: cut at height t of its axis of half-length b, one with
+// half-diagonals a and c has area 2ac(1 - |t|/b)², exactly, whatever its triangles.
+TEST(Parting, SectionAreaOfAnOctahedronIsItsRhombus) {
+  const double a = 10e-3, b = 6e-3, c = 20e-3;
+  const mesh::TriMesh octahedron = octahedron_of(a, b, c);
+  ASSERT_GT(mesh::signed_volume(octahedron), 0);
+  for (const double t : {-19e-3, -7.5e-3, 0.0, 3e-3, 19.9e-3}) {
+    const double rhombus = 2 * a * b * std::pow(1 - std::abs(t) / c, 2);
+    EXPECT_NEAR(mesh::section_area(octahedron, t), rhombus, 1e-12 * a * b) << t;
+  }
+  EXPECT_EQ(mesh::section_area(octahedron, 21e-3), 0.0);
+  // The widest of 256 levels: the two beside the equator are alike, and the higher is taken.
+  EXPECT_NEAR(mesh::widest_section_z(octahedron), c / 256, 1e-15);
+  // Its largest outline is along y (2ac, against 2bc and 2ab).
+  EXPECT_EQ(mesh::lying_flat(octahedron), (mesh::Up{1, 1}));
+  EXPECT_FALSE(mesh::has_flat_extreme(octahedron));
+}
+
+// A part with no flat face at any extreme (an octahedron, half-axes 10, 6 and 20 mm) is read
+// lying flat, up along the axis of its largest outline (y), and cut at its widest section: the
+// cavity is the part below, its volume 2ac b/3 (2 - (1 - h/b)³) for the cut h above the
+// equator, its opening the rhombus there. die.parting = "opening" refuses it by name instead.
+TEST(Parting, APartWithNoFlatFaceIsCutAtItsWidestSection) {
+  const double a = 10e-3, b = 6e-3, c = 20e-3;
+  const mesh::TriMesh octahedron = octahedron_of(a, b, c);
+  test::TempDir dir;
+  mesh::write_stl(octahedron, dir / "octahedron.stl", mesh::LengthUnit::mm, "octahedron");
+  const mesh::DieFile file =
+      mesh::read_die_file(dir / "octahedron.stl", mesh::LengthUnit::mm, std::nullopt, mesh::Parting::automatic);
+  EXPECT_EQ(file.up, (mesh::Up{1, 1}));
+  EXPECT_TRUE(file.up_found);
+  ASSERT_TRUE(file.parting_z.has_value());
+  const double h = b / 256;  // the higher of the two levels beside the equator
+  EXPECT_NEAR(*file.parting_z, h, 1e-12);
+  mesh::DieOptions options = mesh::die_options_for_grains(1e-3, 0.5e-3, 0.5e-3);
+  const mesh::PreparedDie die = mesh::prepare_die(file, options, std::nullopt);
+  const double below = 2 * a * c * b / 3 * (2 - std::pow(1 - h / b, 3));
+  EXPECT_NEAR(mesh::signed_volume(die.cavity), below, 1e-9 * below);
+  EXPECT_TRUE(die.after.closed);
+  EXPECT_EQ(die.after.self_intersections, 0u);
+  EXPECT_NEAR(mesh::bounding_box(die.cavity).hi.z(), h, 1e-12);
+  EXPECT_DOUBLE_EQ(die.table_z, mesh::bounding_box(die.cavity).hi.z());
+  EXPECT_NEAR(mesh::opening_area(die.cavity, mesh::Up{}), 2 * a * c * std::pow(1 - h / b, 2), 1e-9 * a * c);
+  ASSERT_EQ(die.actions.size(), 1u);
+  EXPECT_NE(die.actions.front().find("widest section"), std::string::npos) << die.actions.front();
+  try {
+    mesh::read_die_file(dir / "octahedron.stl", mesh::LengthUnit::mm, std::nullopt, mesh::Parting::opening);
+    ADD_FAILURE() << "an octahedron has no flat opening";
+  } catch (const diefill::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("octahedron.stl"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no flat face"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(mesh::parse_parting("widest", "die.parting"), mesh::Parting::widest);
+  EXPECT_THROW(mesh::parse_parting("middle", "die.parting"), diefill::InputError);
 }
 
 // Read from a file with its opening facing -x, the die is the same cavity as the one facing up:

@@ -536,12 +536,13 @@ TEST(PipelineOwnRuns, ClumpGrainsFillTheRingWithoutLeaking) {
 // re-meshed and its shells united, and the run stops where it should, clearly: the mesh has no
 // flat top face, so it is no die cavity. Told that its opening faces +z, it goes through the
 // repair to that message; left to find its opening, it is refused as it is read, as having no
-// flat face at any extreme.
+// flat face at any extreme. Both with die.parting = "opening": the default would cut the part
+// at its widest section instead.
 TEST(PipelineOwnRuns, MeshThatCrashedCorefinementIsRefusedClearly) {
   REQUIRE_SHARED_MESHES();
   for (const auto& [up, message] : {std::pair{"+z", "no flat top face"}, std::pair{"auto", "no flat face at its extreme"}}) {
     app::PipelineScene scene = app::load_pipeline_scene(
-        std::nullopt, {"powder.max_grains=3000", std::string("die.up=") + up, "output.directory=" + (suite_out() / "refused").string()});
+        std::nullopt, {"powder.max_grains=3000", std::string("die.up=") + up, "die.parting=opening", "output.directory=" + (suite_out() / "refused").string()});
     try {
       app::run_die_fill(scene, test::shared_meshes() / "dies" / "broken" / "assimp_3DSMaxExport.stl", false);
       ADD_FAILURE() << "the mesh was accepted";
