@@ -256,6 +256,13 @@ std::optional<TriMesh> winding_number_solid(const SurfaceMesh& sm, const MeshRep
         "the result, at ({:.4g}, {:.4g}, {:.4g}) mm",
         mm(options.closable_gap_m), mm(solid.gap_closed_m), at.x(), at.y(), at.z()));
   }
+  if (solid.contact_joined_m > solid.moved_m) {
+    const Vec3 at = 1e3 * solid.contact_joined_at;
+    result.actions.push_back(fmt::format(
+        "joined parts in contact (less than {} apart, as an assembly's parts are by their faceting): their faces lie "
+        "up to {} inside the result, at ({:.4g}, {:.4g}, {:.4g}) mm",
+        mm(detail::contact_gap_m), mm(solid.contact_joined_m), at.x(), at.y(), at.z()));
+  }
   result.winding_moved_m = solid.moved_m;
   return std::move(solid.mesh);
 }

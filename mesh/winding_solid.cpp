@@ -11,6 +11,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <optional>
 #include <cmath>
@@ -18,6 +19,7 @@
 #include <memory>
 #include <mutex>
 #include <tuple>
+#include <utility>
 #include <unordered_map>
 
 #include "core/log.hpp"
@@ -165,6 +167,54 @@ std::vector<Vec3> put_back_folds(TriMesh& mesh, const std::vector<Vec3>& unmoved
   }
 }
 
+// Whether `outside`, a point `offset` off a face on the side of winding number < ½, lies in a
+// sliver of outside between parts in contact: a segment through it of `contact_gap_m` at most,
+// along one of 13 directions (the axes, the faces' and the cube's diagonals: one within 30° of
+// any), has both ends in the solid. The segment is shorter than twice `offset`, so that the face
+// the point stands off and a wall meeting it in a corner are never its two ends.
+bool in_contact_sliver(const Vec3& outside, double offset, const WindingNumber& winding, const ExactSurface& surface) {
+  const double reach = std::min(0.5 * contact_gap_m, 0.5 * offset);
+  if (surface.distance(outside) > reach) return false;
+  static const std::array<Vec3, 13> lines = [] {
+    std::array<Vec3, 13> d;
+    int n = 0;
+    for (int x = -1; x <= 1; ++x)
+      for (int y = -1; y <= 1; ++y)
+        for (int z = -1; z <= 1; ++z) {
+          const Vec3 v(x, y, z);
+          // one of each pair ±v: the first nonzero coordinate positive
+          if ((x > 0) || (x == 0 && y > 0) || (x == 0 && y == 0 && z > 0)) d[std::size_t(n++)] = v.normalized();
+        }
+    return d;
+  }();
+  return std::any_of(lines.begin(), lines.end(), [&](const Vec3& d) {
+    return winding(outside + reach * d) >= 0.5 && winding(outside - reach * d) >= 0.5;
+  });
+}
+
+// Input points the result covers though they bound the region, gathered from every core: the
+// faces of closed gaps or of parts in contact, and the farthest of them inside the result.
+struct CoveredFaces {
+  std::mutex mutex;
+  std::vector<Vec3> points;
+
+  void add(const Vec3& p) {
+    const std::lock_guard<std::mutex> lock(mutex);
+    points.push_back(p);
+  }
+  // The farthest point from `result`'s surface and its distance, over points in a fixed order.
+  std::pair<double, Vec3> farthest(const ExactSurface* result) {
+    std::sort(points.begin(), points.end(),
+              [](const Vec3& a, const Vec3& b) { return std::tie(a.x(), a.y(), a.z()) < std::tie(b.x(), b.y(), b.z()); });
+    std::pair<double, Vec3> out{0.0, Vec3::Zero()};
+    for (const Vec3& p : points) {
+      const double depth = result->distance(p);
+      if (depth > out.first) out = {depth, p};
+    }
+    return out;
+  }
+};
+
 // A grain of radius `radius_m` against the input: whether it can touch a point of its bounding
 // surface from the free space, which lies inside the solid or outside it.
 struct GrainProbe {
@@ -216,36 +266,37 @@ WindingSolid on_input(TriMesh zero, const TriMesh& soup, const ExactSurface& sur
   out.folded_at = put_back_folds(zero, unmoved);
   // What bounds the region in the input: sample points whose two sides fall on either side
   // of ½ (a quarter cell off the face); faces buried inside or left in the open do not. Nor do
-  // those the result covers where no grain of the closable diameter can touch them from the free
-  // space (`gaps`): there the cells are too coarse to keep the free space open, and no grain
-  // could tell (README, "Mesh repair").
+  // faces of parts in contact, across a sliver of outside (`in_contact_sliver`), nor those the
+  // result covers where no grain of the closable diameter can touch them from the free space
+  // (`gaps`): there the cells are too coarse to keep the free space open, and no grain could
+  // tell (README, "Mesh repair").
   const double offset = 0.25 * cell_m;
   const GrainProbe grain{winding, surface, 0.5 * gaps.closable_m};
   // The samples are asked on every core (farthest_sample): the result's exact surface is built
-  // once, by the first sample that needs it, and the gap faces are taken in a fixed order after.
+  // once, by the first sample that needs it.
   std::unique_ptr<ExactSurface> result;
   std::once_flag result_built;
-  std::mutex gap_faces_mutex;
-  std::vector<Vec3> gap_faces;
+  const auto build_result = [&] { std::call_once(result_built, [&] { result = std::make_unique<ExactSurface>(zero); }); };
+  CoveredFaces gap_faces, contact_faces;
   FarthestSample moved = farthest_sample(
       soup, zero,
       [&](const Vec3& p, const Vec3& normal) {
         const bool solid_ahead = winding(p + offset * normal) >= 0.5;
         if (solid_ahead == (winding(p - offset * normal) >= 0.5)) return false;
+        if (in_contact_sliver(p + (solid_ahead ? -offset : offset) * normal, offset, winding, surface)) {
+          build_result();
+          contact_faces.add(p);
+          return false;
+        }
         if (grain.radius_m <= 0.0 || grain.touches(p, normal, solid_ahead, gaps.free_space_inside)) return true;
-        std::call_once(result_built, [&] { result = std::make_unique<ExactSurface>(zero); });
+        build_result();
         if (result->inside(p) == gaps.free_space_inside) return true;  // the result keeps the free space
-        const std::lock_guard<std::mutex> lock(gap_faces_mutex);
-        gap_faces.push_back(p);
+        gap_faces.add(p);
         return false;
       },
       beyond ? cell_m : std::numeric_limits<double>::infinity());
-  std::sort(gap_faces.begin(), gap_faces.end(),
-            [](const Vec3& a, const Vec3& b) { return std::tie(a.x(), a.y(), a.z()) < std::tie(b.x(), b.y(), b.z()); });
-  for (const Vec3& p : gap_faces) {
-    const double depth = result->distance(p);
-    if (depth > out.gap_closed_m) out.gap_closed_m = depth, out.gap_closed_at = p;
-  }
+  std::tie(out.gap_closed_m, out.gap_closed_at) = gap_faces.farthest(result.get());
+  std::tie(out.contact_joined_m, out.contact_joined_at) = contact_faces.farthest(result.get());
   out.moved_across_thin_solid = grain.radius_m > 0.0 && moved.distance_m > 0.0 &&
                                 !grain.touches(moved.point, moved.normal,
                                                winding(moved.point + offset * moved.normal) >= 0.5, !gaps.free_space_inside);

@@ -19,6 +19,15 @@ struct WindingSurvey {
 };
 WindingSurvey survey_winding(const TriMesh& soup, int cells = 96);
 
+// Parts of an assembly that touch leave between their faces only what their faceting leaves:
+// the toothed pulley of the shared dies (a cycloidal drive of 100 shells) holds pins of 1.5875 mm
+// radius, 31-gons, in bores of the same radius, 34-gons, at most 5.5 µm apart (all 660 such
+// slivers of the file within 0.03 mm), while its designed clearances are 0.397 mm. Outside of
+// the solid that a segment this long spans from solid to solid (crossed squarely through its
+// middle: up to half of it from a face) is such a contact, which the model means as solid
+// throughout, not a gap (README, "Mesh repair"); a die wall 0.15 mm thick is no contact.
+constexpr double contact_gap_m = 0.1e-3;
+
 struct WindingSolid {
   // Closed, outward, crossing nowhere (else folded_at says where); empty when the region is
   // empty or could not be closed.
@@ -35,6 +44,10 @@ struct WindingSolid {
   // and the point.
   double gap_closed_m = 0.0;
   Vec3 gap_closed_at = Vec3::Zero();
+  // Faces of parts in contact (an assembly's, apart by their faceting alone), which the result
+  // joins, not counted in `moved_m` either: the farthest such point from the result [m], and it.
+  double contact_joined_m = 0.0;
+  Vec3 contact_joined_at = Vec3::Zero();
   // Whether the solid at `moved_most_at` is thinner than the closable diameter: the re-mesh
   // joined two parts of the free space across it (a die wall between two cavities).
   bool moved_across_thin_solid = false;

@@ -41,14 +41,15 @@ DieSource read_die(const PipelineScene& scene, const std::filesystem::path& die_
                        die.file.name, mesh::up_name(die.file.up));
   die.box = mesh::bounding_box(die.file.mesh);
   if (die.file.parting_z) {
-    diefill::log::warn("{}: it has no flat face the die could open on{}; the die table cuts it at its widest section, "
-                       "{:.4g} mm above its lowest point, and the upper punch would form the part above. Set "
+    // The height of the cut is said once, by the repair action that makes it (mesh/die.cpp), on
+    // the repaired part: repair may move the part's lowest point, so a figure here could differ.
+    diefill::log::warn("{}: it has no flat face the die could open on{}; the die table cuts it at its widest section "
+                       "(its repair actions, logged and in the report, say where), and the upper punch would form the part above. Set "
                        "die.parting = \"opening\" to refuse such a part",
                        die.file.name,
                        die.file.up_found ? fmt::format(" (laid flat: up is {} in the file, the axis of its largest outline)",
                                                        mesh::up_name(die.file.up))
-                                         : "",
-                       (*die.file.parting_z - die.box.lo.z()) * 1e3);
+                                         : "");
     die.box.hi.z() = *die.file.parting_z;
   }
   die.table_z = die.box.hi.z();

@@ -122,6 +122,7 @@ FillWalls prepare_walls(const PipelineScene& s, const DieSource& source, const G
   w.cache = s.cache.empty() ? s.out / ".cache" : s.cache;
   const mesh::DieOptions options = die_options(s, grains, shoe, source);
   w.die = mesh::prepare_die(source.file, options, w.cache);
+  for (const std::string& action : w.die.actions) diefill::log::info("{}: {}", source.file.name, action);
   w.die_field = std::make_shared<const mesh::WallField>(w.die.sdf.wall_field(w.die.solid));
   w.shoe_field = shoe_field(s, grains, shoe, options.unit, w.cache);
   check_grains_enter(w, source, grains);
