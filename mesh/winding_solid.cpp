@@ -169,9 +169,9 @@ std::vector<Vec3> put_back_folds(TriMesh& mesh, const std::vector<Vec3>& unmoved
 
 // Whether `outside`, a point `offset` off a face on the side of winding number < ½, lies in a
 // sliver of outside between parts in contact: a segment through it of `contact_gap_m` at most,
-// along one of 13 directions (the axes, the faces' and the cube's diagonals: one within 30° of
-// any), has both ends in the solid. The segment is shorter than twice `offset`, so that the face
-// the point stands off and a wall meeting it in a corner are never its two ends.
+// along one of 13 directions (the axes, the faces' and the cube's diagonals: one within 28° of
+// any), has both ends in the solid. Each half of the segment is at most half of `offset`, so
+// that the face the point stands off and a wall meeting it in a corner are never its two ends.
 bool in_contact_sliver(const Vec3& outside, double offset, const WindingNumber& winding, const ExactSurface& surface) {
   const double reach = std::min(0.5 * contact_gap_m, 0.5 * offset);
   if (surface.distance(outside) > reach) return false;

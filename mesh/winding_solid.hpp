@@ -24,7 +24,8 @@ WindingSurvey survey_winding(const TriMesh& soup, int cells = 96);
 // radius, 31-gons, in bores of the same radius, 34-gons, at most 5.5 µm apart (all 660 such
 // slivers of the file within 0.03 mm), while its designed clearances are 0.397 mm. Outside of
 // the solid that a segment this long spans from solid to solid (crossed squarely through its
-// middle: up to half of it from a face) is such a contact, which the model means as solid
+// middle: up to half of it from a face; on cells under 0.4 mm, shorter, as in_contact_sliver
+// says) is such a contact, which the model means as solid
 // throughout, not a gap (README, "Mesh repair"); a die wall 0.15 mm thick is no contact.
 constexpr double contact_gap_m = 0.1e-3;
 
