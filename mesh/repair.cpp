@@ -18,13 +18,14 @@
 
 #include <algorithm>
 #include <optional>
-
+#include <stdexcept>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/timer.hpp"
-#include "mesh/versions.hpp"
 #include "mesh/cgal_ops.hpp"
+#include "mesh/cgal_surface_mesh.hpp"
+#include "mesh/versions.hpp"
 #include "mesh/weld.hpp"
 #include "mesh/winding_solid.hpp"
 
@@ -32,33 +33,13 @@ namespace mesh {
 
 namespace {
 
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Point = K::Point_3;
-using SurfaceMesh = CGAL::Surface_mesh<Point>;
+using Point = detail::CgalPoint;
+using detail::SurfaceMesh;
+using detail::to_trimesh;
 namespace PMP = CGAL::Polygon_mesh_processing;
 using diefill::InputError;
 
 Point to_point(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
-
-TriMesh to_trimesh(const SurfaceMesh& sm) {
-  TriMesh out;
-  std::vector<int> index(sm.number_of_vertices() + sm.number_of_removed_vertices(), -1);
-  for (auto v : sm.vertices()) {
-    index[v.idx()] = int(out.vertices.size());
-    const Point& p = sm.point(v);
-    out.vertices.emplace_back(p.x(), p.y(), p.z());
-  }
-  for (auto f : sm.faces()) {
-    Triangle t{};
-    int k = 0;
-    for (auto v : CGAL::vertices_around_face(sm.halfedge(f), sm)) {
-      if (k < 3) t[k] = index[v.idx()];
-      ++k;
-    }
-    if (k == 3) out.triangles.push_back(t);
-  }
-  return out;
-}
 
 double diameter_of_cycle(const SurfaceMesh& sm, SurfaceMesh::Halfedge_index start) {
   Box box;
@@ -127,13 +108,10 @@ Soup soup_of(const TriMesh& mesh) {
   return soup;
 }
 
+// The repaired mesh back in CGAL's form: it came out of a Surface_mesh, so it is a polygon mesh.
 SurfaceMesh polygon_mesh_of(const TriMesh& mesh) {
-  std::vector<Point> points;
-  for (const Vec3& v : mesh.vertices) points.push_back(to_point(v));
-  std::vector<std::array<std::size_t, 3>> triangles;
-  for (const Triangle& t : mesh.triangles) triangles.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
   SurfaceMesh sm;
-  PMP::polygon_soup_to_polygon_mesh(points, triangles, sm);
+  if (!detail::to_surface_mesh(mesh, sm)) throw std::logic_error("repair: a repaired surface is not a polygon mesh");
   return sm;
 }
 

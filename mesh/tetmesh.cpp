@@ -2,47 +2,41 @@
 // are sampled by protecting balls first, so that the mesh's edges follow them).
 #include "mesh/tetmesh.hpp"
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
 #include <CGAL/Mesh_criteria_3.h>
 #include <CGAL/Mesh_triangulation_3.h>
-#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/repair_degeneracies.h>
 #include <CGAL/Polyhedral_mesh_domain_with_features_3.h>
-#include <CGAL/Surface_mesh.h>
 #include <CGAL/make_mesh_3.h>
 
+#include <algorithm>
+#include <cmath>
 #include <map>
+#include <numbers>
+#include <optional>
+#include <stdexcept>
 
 #include <fmt/core.h>
 
 #include "core/child_process.hpp"
 #include "core/error.hpp"
+#include "mesh/cgal_ops.hpp"
+#include "mesh/cgal_surface_mesh.hpp"
 #include "mesh/repair.hpp"
 #include "mesh/weld.hpp"
 
 namespace mesh {
 
 namespace {
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Point = K::Point_3;
-using SurfaceMesh = CGAL::Surface_mesh<Point>;
+using K = detail::CgalKernel;
+using Point = detail::CgalPoint;
+using detail::SurfaceMesh;
 using Domain = CGAL::Polyhedral_mesh_domain_with_features_3<K, SurfaceMesh>;
 // Sequential: the parallel mesher's result depends on the thread schedule.
 using Tr = CGAL::Mesh_triangulation_3<Domain, CGAL::Default, CGAL::Sequential_tag>::type;
 using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Tr, Domain::Corner_index, Domain::Curve_index>;
 using Criteria = CGAL::Mesh_criteria_3<Tr>;
 
-SurfaceMesh surface_mesh(const TriMesh& m) {
-  std::vector<Point> points;
-  points.reserve(m.vertices.size());
-  for (const Vec3& v : m.vertices) points.emplace_back(v.x(), v.y(), v.z());
-  std::vector<std::array<std::size_t, 3>> faces;
-  faces.reserve(m.triangles.size());
-  for (const Triangle& t : m.triangles) faces.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
-  SurfaceMesh sm;
-  CGAL::Polygon_mesh_processing::polygon_soup_to_polygon_mesh(points, faces, sm);
-  return sm;
-}
 // A cell whose four vertices lie in one plane (to rounding; exactly, they need not) with two or
 // more faces on the boundary: a sliver Mesh_3 can leave lying on a flat part of the surface (on the gear die's wall, between
 // protected edges), which exudation cannot remove and CalculiX refuses ("nonpositive jacobian").
@@ -65,26 +59,76 @@ bool is_flat_boundary_cell(const C3t3& c3t3, const Cell& c) {
   return boundary_faces >= 2;
 }
 
-// Vertices closer than the facet distance welded, when the body stays one closed, oriented
-// surface without degenerate faces or crossings (repair's checks). An edge that short between
-// sharp features (the planetary gear set's ring gear has edges of 2 µm) makes Mesh_3 protect
-// them with balls that small and refine all around them: alone, the ring gear's mesh had not
-// ended after 2 minutes, a planet's took under 30 s. The mesh's boundary may lie the facet
+// One closed, oriented surface without degenerate faces or crossings (repair's checks), or none.
+std::optional<TriMesh> clean_single_body(const TriMesh& mesh) {
+  std::vector<TriMesh> parts = separate_bodies(mesh);  // also drops unused vertices
+  if (parts.size() != 1) return std::nullopt;
+  const MeshReport report = inspect(parts.front());
+  if (!report.closed || report.inconsistent_edges > 0 || report.degenerate_faces > 0 || report.self_intersections > 0)
+    return std::nullopt;
+  return std::move(parts.front());
+}
+
+// Edges shorter than `length` collapsed, one at a time where the surface's topology allows
+// (CGAL's remove_almost_degenerate_faces: a needle threshold of 1 makes every face's shortest
+// edge a candidate, the length bounds which go; the endpoint kept is the one that changes the
+// volume least), and caps no taller than `length` flipped: each vertex moves at most `length`
+// and none is made. Where two sheets of the surface pass closer than `length` (on the turbine
+// blade, at two faces of its cut), a collapse can fold one through the other: the vertices
+// around each crossing face (its box grown by `length`) are then kept as they are and the
+// collapse is done again from the start, a few times at most.
+std::optional<TriMesh> with_short_edges_collapsed(const TriMesh& body, double length) {
+  constexpr int attempts = 4;
+  std::vector<Box> keep_within;
+  for (int attempt = 0; attempt < attempts; ++attempt) {
+    SurfaceMesh sm;
+    if (!detail::to_surface_mesh(body, sm)) return std::nullopt;
+    auto is_kept = sm.add_property_map<SurfaceMesh::Vertex_index, bool>("v:kept", false).first;
+    for (const SurfaceMesh::Vertex_index v : sm.vertices()) {
+      const Vec3 p(sm.point(v).x(), sm.point(v).y(), sm.point(v).z());
+      is_kept[v] = std::any_of(keep_within.begin(), keep_within.end(), [&](const Box& b) {
+        return (p.array() >= b.lo.array()).all() && (p.array() <= b.hi.array()).all();
+      });
+    }
+    const double cap_cosine = std::cos(160 * std::numbers::pi / 180);  // CGAL's example: an angle over 160°
+    CGAL::Polygon_mesh_processing::experimental::remove_almost_degenerate_faces(
+        sm, cap_cosine, 1.0, length,
+        CGAL::parameters::flip_triangle_height_threshold(length).vertex_is_constrained_map(is_kept));
+    TriMesh collapsed = detail::to_trimesh(sm);
+    const std::vector<bool> faulty = detail::faulty_triangles(collapsed);
+    if (std::find(faulty.begin(), faulty.end(), true) == faulty.end()) return clean_single_body(collapsed);
+    for (std::size_t f = 0; f < faulty.size(); ++f) {
+      if (!faulty[f]) continue;
+      Box b;
+      for (const int v : collapsed.triangles[f]) b.extend(collapsed.vertices[std::size_t(v)]);
+      keep_within.push_back({b.lo - Vec3::Constant(length), b.hi + Vec3::Constant(length)});
+    }
+  }
+  return std::nullopt;
+}
+
+// Edges shorter than the facet distance removed before meshing: an edge that short between sharp
+// features makes Mesh_3 protect them with balls that small and refine all around them (the
+// planetary gear set's ring gear has edges of 2 µm: alone, its mesh had not ended after 2
+// minutes, a planet's took under 30 s), and leaves elements CalculiX refuses (the turbine
+// blade's edges of 0.2-0.5 µm, README, "Shared dies through the pipeline"). First the vertices
+// that close welded, which also closes a seam folding through itself in slivers that thin;
+// where that crosses the surface (the blade), the short edges collapsed along the surface;
+// where neither leaves a clean body, the body as it is. The mesh's boundary may lie the facet
 // distance from the surface anyway.
 TriMesh without_edges_shorter_than(const TriMesh& body, double length) {
   const WeldedMesh welded = weld_close_vertices(body, length);
   if (welded.merged == 0) return body;
-  std::vector<TriMesh> parts = separate_bodies(welded.mesh);  // also drops the welded vertices
-  if (parts.size() != 1) return body;
-  const MeshReport welded_report = inspect(parts.front());
-  if (!welded_report.closed || welded_report.inconsistent_edges > 0 || welded_report.degenerate_faces > 0 ||
-      welded_report.self_intersections > 0)
-    return body;
-  return std::move(parts.front());
+  if (std::optional<TriMesh> clean = clean_single_body(welded.mesh)) return std::move(*clean);
+  if (std::optional<TriMesh> clean = with_short_edges_collapsed(body, length)) return std::move(*clean);
+  return body;
 }
 
 TetMesh tetrahedralise_body(const TriMesh& body, const TetMeshOptions& o) {
-  SurfaceMesh sm = surface_mesh(without_edges_shorter_than(body, o.facet_distance_m));
+  SurfaceMesh sm;
+  // In the child process (tetrahedralise): its failure is reported with the remedy there.
+  if (!detail::to_surface_mesh(without_edges_shorter_than(body, o.facet_distance_m), sm))
+    throw std::invalid_argument("the surface is not a polygon mesh");
   CGAL::Random seeded(0);  // the domain's own sampling; make_mesh_3 reseeds CGAL's default generator
   Domain domain(sm, &seeded);
   domain.detect_features(o.feature_angle_deg);

@@ -1,56 +1,23 @@
 // Exact union of intersecting closed shells, and the clip of a solid by a plane, by corefinement
 // (CGAL PMP), in their own translation unit: corefinement is the heaviest CGAL header the project uses.
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/clip.h>
 #include <CGAL/Polygon_mesh_processing/connected_components.h>
 #include <CGAL/Polygon_mesh_processing/corefinement.h>
 #include <CGAL/Polygon_mesh_processing/orientation.h>
 #include <CGAL/Polygon_mesh_processing/measure.h>
-#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
-#include <CGAL/Surface_mesh.h>
 
 #include <cstdint>
 
 #include "core/child_process.hpp"
 #include "core/log.hpp"
 #include "mesh/cgal_ops.hpp"
+#include "mesh/cgal_surface_mesh.hpp"
 
 namespace mesh::detail {
 
 namespace {
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Point = K::Point_3;
-using SurfaceMesh = CGAL::Surface_mesh<Point>;
 namespace PMP = CGAL::Polygon_mesh_processing;
-
-TriMesh to_trimesh(const SurfaceMesh& sm) {
-  TriMesh out;
-  std::vector<int> index(sm.number_of_vertices() + sm.number_of_removed_vertices(), -1);
-  for (auto v : sm.vertices()) {
-    index[v.idx()] = int(out.vertices.size());
-    const Point& p = sm.point(v);
-    out.vertices.emplace_back(p.x(), p.y(), p.z());
-  }
-  for (auto f : sm.faces()) {
-    Triangle t{};
-    int k = 0;
-    for (auto v : CGAL::vertices_around_face(sm.halfedge(f), sm)) t[k++] = index[v.idx()];
-    out.triangles.push_back(t);
-  }
-  return out;
-}
-
-// False when the triangles do not form a polygon mesh (an edge shared the wrong way).
-bool to_surface_mesh(const TriMesh& mesh, SurfaceMesh& out) {
-  std::vector<Point> points;
-  for (const Vec3& v : mesh.vertices) points.emplace_back(v.x(), v.y(), v.z());
-  std::vector<std::array<std::size_t, 3>> faces;
-  for (const Triangle& t : mesh.triangles) faces.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
-  if (!PMP::is_polygon_soup_a_polygon_mesh(faces)) return false;
-  PMP::polygon_soup_to_polygon_mesh(points, faces, out);
-  return true;
-}
 
 bool union_in_this_process(const TriMesh& closed_shells, UnionResult& out) {
   SurfaceMesh all;
@@ -160,7 +127,7 @@ bool clip_below(const TriMesh& closed, double height, TriMesh& out) {
   SurfaceMesh sm;
   if (!to_surface_mesh(closed, sm) || !CGAL::is_closed(sm)) return false;
   // The plane's negative side is kept: below z = height.
-  if (!PMP::clip(sm, K::Plane_3(0, 0, 1, -height), CGAL::parameters::clip_volume(true))) return false;
+  if (!PMP::clip(sm, CgalKernel::Plane_3(0, 0, 1, -height), CGAL::parameters::clip_volume(true))) return false;
   sm.collect_garbage();
   if (sm.is_empty() || !CGAL::is_closed(sm)) return false;
   out = to_trimesh(sm);

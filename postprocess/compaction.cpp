@@ -72,6 +72,10 @@ double constrained_modulus(double e, double nu) { return e * (1 - nu) / ((1 + nu
 CompactionResult run_compaction(const FemFill& f, const fs::path& dir, const CompactionSettings& s) {
   double floor_z = f.mesh.nodes.front().z(), table_z = floor_z;
   for (const Vec3& p : f.mesh.nodes) floor_z = std::min(floor_z, p.z()), table_z = std::max(table_z, p.z());
+  if (boundary_sets(f.mesh, table_z).table.empty())
+    throw diefill::InputError((dir / "fill.inp").string(), "TABLE",
+                              "no boundary face of the mesh lies in its top plane, so the punch would press nothing",
+                              "Check that the die's cavity has its flat opening on the table");
   CompactionResult r;
   r.punch_travel_m = s.axial_strain * (table_z - floor_z);
   diefill::write_file_atomic(dir / "compaction.inp", deck(f, r.punch_travel_m, s));

@@ -9,6 +9,7 @@
 #include "mesh/die.hpp"
 #include "mesh/shapes.hpp"
 #include "postprocess/compaction.hpp"
+#include "postprocess/fem.hpp"
 #include "postprocess/sphere_box.hpp"
 #include "support.hpp"
 
@@ -24,6 +25,17 @@ double mesh_volume(const mesh::TetMesh& m) {
   double v = 0;
   for (const mesh::Tet& t : m.tets) v += mesh::tet_volume(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]], m.nodes[t[3]]);
   return v;
+}
+
+// The area of a surface's faces whose corners all lie at `z` or above.
+template <class Nodes, class Faces>
+double area_at_or_above(const Nodes& nodes, const Faces& faces, double z) {
+  double area = 0;
+  for (const auto& f : faces) {
+    const Vec3 &a = nodes[std::size_t(f[0])], &b = nodes[std::size_t(f[1])], &c = nodes[std::size_t(f[2])];
+    if (std::min({a.z(), b.z(), c.z()}) >= z) area += 0.5 * (b - a).cross(c - a).norm();
+  }
+  return area;
 }
 
 // The ring meshed as the pipeline meshes it for 0.8 mm grains: elements of 1.6 mm.
@@ -163,6 +175,62 @@ TEST(TetMesh, EdgesShorterThanTheFacetDistanceShrinkNoElement) {
       for (int j = i + 1; j < 4; ++j) shortest = std::min(shortest, (m.nodes[t[i]] - m.nodes[t[j]]).norm());
   EXPECT_GT(shortest, 1e-4);
   EXPECT_NEAR(mesh_volume(m), a * a * a, 1e-3 * a * a * a);
+}
+
+// CalculiX refuses an element whose Jacobian determinant is under 1e-20 ("nonpositive jacobian",
+// e_c3d.f: `if(xsj.lt.1.d-20)`), an absolute bound in the deck's units (SI): 6 V of a tetrahedron
+// with straight edges. The shared turbine blade, cut at its widest section as the pipeline cuts
+// it and meshed at that run's elements (1.81 mm), had 28 such elements, 0.2-0.5 µm across, where
+// its surface has edges that short (README, "Shared dies through the pipeline").
+TEST(TetMesh, SharedTurbineBladeCavityHasNoElementCalculiXRefuses) {
+  REQUIRE_SHARED_MESHES();
+  const double grain_radius = 0.453e-3, element = 1.8129e-3;
+  mesh::DieOptions o = mesh::die_options_for_grains(grain_radius, 0.5 * grain_radius, 0.25 * grain_radius);
+  o.unit = mesh::LengthUnit::mm;
+  o.role = mesh::WallRole::cavity;
+  const mesh::PreparedDie die =
+      mesh::prepare_die(test::shared_meshes() / "dies" / "large_turbineblade_vtk_199k.ply", o, std::nullopt);
+  const mesh::TetMesh m = mesh::tetrahedralise(die.cavity, {element, element / 200, 60}, "blade");
+  std::size_t refused = 0;
+  double smallest = 1;
+  for (const mesh::Tet& t : m.tets) {
+    const double jacobian = 6 * mesh::tet_volume(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]], m.nodes[t[3]]);
+    refused += jacobian < 1e-20;
+    smallest = std::min(smallest, jacobian);
+  }
+  EXPECT_EQ(refused, 0u) << "of " << m.tets.size() << " elements; the smallest 6 V is " << smallest << " m³";
+  // The punch presses the cut: the deck's TABLE faces lie in the opening, the cavity's faces in
+  // its top plane, and cover most of it (along the rim, where the blade meets the cut at a
+  // shallow angle, the mesher may tilt a facet out of the plane within the facet distance).
+  double top = -1, top_node = -1;
+  for (const Vec3& p : die.cavity.vertices) top = std::max(top, p.z());
+  for (const Vec3& p : m.nodes) top_node = std::max(top_node, p.z());
+  const double opening = area_at_or_above(die.cavity.vertices, die.cavity.triangles, top - 1e-12);  // the cut's rounding
+  const double table = area_at_or_above(m.nodes, post::boundary_sets(m, top_node).table, -1.0);
+  EXPECT_LE(table, opening * (1 + 1e-9));
+  EXPECT_GT(table, 0.9 * opening) << "the punch presses the cut (with a node 1.85 nm above its plane, it pressed nothing)";
+  // The boundary lies within the facet distance of the surface: the volume within that times its area.
+  EXPECT_NEAR(mesh_volume(m), die.after.volume_m3, element / 200 * die.after.area_m2);
+}
+
+// Mesh_3 places a flat face's nodes by its constructions: in a pipeline run on the turbine blade
+// one table node lay 1.85 nm above the rest, and the table, taken as the highest node's plane,
+// had no face left, so the compaction example's punch pressed nothing. The ring's table with one
+// node raised that much keeps every face it had, and they cover the ring's top (to the corners
+// the mesh's rim cuts off the file's 104-gons, less than 0.1 %).
+TEST(FemFiles, TheTableKeepsItsFacesWhenANodeLiesNanometresAboveIt) {
+  mesh::TetMesh m = ring_mesh();
+  double top = -1;
+  for (const Vec3& p : m.nodes) top = std::max(top, p.z());
+  const std::size_t faces = post::boundary_sets(m, top).table.size();
+  const auto on_top = std::find_if(m.nodes.begin(), m.nodes.end(), [&](const Vec3& p) { return p.z() == top; });
+  ASSERT_NE(on_top, m.nodes.end());
+  on_top->z() += 1.85e-9;
+  const post::BoundarySets raised = post::boundary_sets(m, top + 1.85e-9);
+  EXPECT_EQ(raised.table.size(), faces);
+  const mesh::TriMesh ring = bundled("ring");
+  const double opening = area_at_or_above(ring.vertices, ring.triangles, top);
+  EXPECT_NEAR(area_at_or_above(m.nodes, raised.table, -1.0), opening, 1e-3 * opening);
 }
 
 TEST(FemFill, KeepsALatticeFlatUpToTheWallsAndConservesItsVolume) {
