@@ -112,16 +112,17 @@ std::optional<TriMesh> with_short_edges_collapsed(const TriMesh& body, double le
 // planetary gear set's ring gear has edges of 2 µm: alone, its mesh had not ended after 2
 // minutes, a planet's took under 30 s), and leaves elements CalculiX refuses (the turbine
 // blade's edges of 0.2-0.5 µm, README, "Shared dies through the pipeline"). First the vertices
-// that close welded, which also closes a seam folding through itself in slivers that thin;
-// where that crosses the surface (the blade), the short edges collapsed along the surface;
-// where neither leaves a clean body, the body as it is. The mesh's boundary may lie the facet
-// distance from the surface anyway.
+// that close welded, which also closes a seam folding through itself in slivers that thin, where
+// that leaves a clean body (on the blade it crosses the surface); then, on that or the body as
+// it is, the short edges collapsed and the flat caps flipped along the surface (the flanged
+// ring's re-mesh has caps 0.1 µm high, which welding leaves). The mesh's boundary may lie the
+// facet distance from the surface anyway.
 TriMesh without_edges_shorter_than(const TriMesh& body, double length) {
-  const WeldedMesh welded = weld_close_vertices(body, length);
-  if (welded.merged == 0) return body;
-  if (std::optional<TriMesh> clean = clean_single_body(welded.mesh)) return std::move(*clean);
-  if (std::optional<TriMesh> clean = with_short_edges_collapsed(body, length)) return std::move(*clean);
-  return body;
+  std::optional<TriMesh> welded;
+  if (const WeldedMesh w = weld_close_vertices(body, length); w.merged > 0) welded = clean_single_body(w.mesh);
+  const TriMesh& base = welded ? *welded : body;
+  if (std::optional<TriMesh> clean = with_short_edges_collapsed(base, length)) return std::move(*clean);
+  return base;
 }
 
 TetMesh tetrahedralise_body(const TriMesh& body, const TetMeshOptions& o) {

@@ -177,20 +177,30 @@ TEST(TetMesh, EdgesShorterThanTheFacetDistanceShrinkNoElement) {
   EXPECT_NEAR(mesh_volume(m), a * a * a, 1e-3 * a * a * a);
 }
 
+// Shared dies meshed as their pipeline runs mesh them (README, "Shared dies through the
+// pipeline"): the largest grain radius, the SDF voxel and the element size of that run.
+struct SharedCavity {
+  const char* file;
+  mesh::LengthUnit unit;
+  double grain_radius_m, voxel_m, element_m;
+};
+void PrintTo(const SharedCavity& c, std::ostream* os) { *os << c.file; }
+class SharedCavityMesh : public ::testing::TestWithParam<SharedCavity> {};
+
 // CalculiX refuses an element whose Jacobian determinant is under 1e-20 ("nonpositive jacobian",
 // e_c3d.f: `if(xsj.lt.1.d-20)`), an absolute bound in the deck's units (SI): 6 V of a tetrahedron
-// with straight edges. The shared turbine blade, cut at its widest section as the pipeline cuts
-// it and meshed at that run's elements (1.81 mm), had 28 such elements, 0.2-0.5 µm across, where
-// its surface has edges that short (README, "Shared dies through the pipeline").
-TEST(TetMesh, SharedTurbineBladeCavityHasNoElementCalculiXRefuses) {
+// with straight edges. The turbine blade (cut at its widest section) had 28 such elements,
+// 0.2-0.5 µm across, where its surface has edges that short; the flanged ring 35,117, at caps of
+// its re-mesh 0.1 µm high.
+TEST_P(SharedCavityMesh, HasNoElementCalculiXRefuses) {
   REQUIRE_SHARED_MESHES();
-  const double grain_radius = 0.453e-3, element = 1.8129e-3;
-  mesh::DieOptions o = mesh::die_options_for_grains(grain_radius, 0.5 * grain_radius, 0.25 * grain_radius);
-  o.unit = mesh::LengthUnit::mm;
+  const SharedCavity& c = GetParam();
+  mesh::DieOptions o = mesh::die_options_for_grains(c.grain_radius_m, 0.5 * c.grain_radius_m, c.voxel_m);
+  o.unit = c.unit;
   o.role = mesh::WallRole::cavity;
-  const mesh::PreparedDie die =
-      mesh::prepare_die(test::shared_meshes() / "dies" / "large_turbineblade_vtk_199k.ply", o, std::nullopt);
-  const mesh::TetMesh m = mesh::tetrahedralise(die.cavity, {element, element / 200, 60}, "blade");
+  const mesh::PreparedDie die = mesh::prepare_die(test::shared_meshes() / "dies" / c.file, o, std::nullopt);
+  const double facet_distance = c.element_m / 200;
+  const mesh::TetMesh m = mesh::tetrahedralise(die.cavity, {c.element_m, facet_distance, 60}, c.file);
   std::size_t refused = 0;
   double smallest = 1;
   for (const mesh::Tet& t : m.tets) {
@@ -199,19 +209,24 @@ TEST(TetMesh, SharedTurbineBladeCavityHasNoElementCalculiXRefuses) {
     smallest = std::min(smallest, jacobian);
   }
   EXPECT_EQ(refused, 0u) << "of " << m.tets.size() << " elements; the smallest 6 V is " << smallest << " m³";
-  // The punch presses the cut: the deck's TABLE faces lie in the opening, the cavity's faces in
-  // its top plane, and cover most of it (along the rim, where the blade meets the cut at a
-  // shallow angle, the mesher may tilt a facet out of the plane within the facet distance).
+  // The punch presses the opening: the deck's TABLE faces lie in it, the cavity's faces in its top
+  // plane, and cover most of it (along the rim, where the blade meets its cut at a shallow angle,
+  // the mesher may tilt a facet out of the plane within the facet distance).
   double top = -1, top_node = -1;
   for (const Vec3& p : die.cavity.vertices) top = std::max(top, p.z());
   for (const Vec3& p : m.nodes) top_node = std::max(top_node, p.z());
-  const double opening = area_at_or_above(die.cavity.vertices, die.cavity.triangles, top - 1e-12);  // the cut's rounding
+  const double opening = area_at_or_above(die.cavity.vertices, die.cavity.triangles, top - 1e-12);  // a cut's rounding
   const double table = area_at_or_above(m.nodes, post::boundary_sets(m, top_node).table, -1.0);
   EXPECT_LE(table, opening * (1 + 1e-9));
-  EXPECT_GT(table, 0.9 * opening) << "the punch presses the cut (with a node 1.85 nm above its plane, it pressed nothing)";
+  EXPECT_GT(table, 0.9 * opening) << "the punch presses the opening (with a node 1.85 nm above it, it pressed nothing)";
   // The boundary lies within the facet distance of the surface: the volume within that times its area.
-  EXPECT_NEAR(mesh_volume(m), die.after.volume_m3, element / 200 * die.after.area_m2);
+  EXPECT_NEAR(mesh_volume(m), die.after.volume_m3, facet_distance * die.after.area_m2);
 }
+
+INSTANTIATE_TEST_SUITE_P(
+    Pipeline, SharedCavityMesh,
+    ::testing::Values(SharedCavity{"large_turbineblade_vtk_199k.ply", mesh::LengthUnit::mm, 0.453e-3, 0.25 * 0.453e-3, 1.8129e-3},
+                      SharedCavity{"flanged_ring_trimesh_idler_riser.stl", mesh::LengthUnit::in, 0.9125e-3, 0.365e-3, 3.3179e-3}));
 
 // Mesh_3 places a flat face's nodes by its constructions: in a pipeline run on the turbine blade
 // one table node lay 1.85 nm above the rest, and the table, taken as the highest node's plane,
@@ -378,4 +393,3 @@ TEST(FemFiles, AreReadByMeshioWithTheirArrays) {
     EXPECT_LT(density_error, 1e-4);
   }
 }
-
