@@ -2,8 +2,6 @@
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
 #include <CGAL/AABB_triangle_primitive.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Surface_mesh.h>
 #include <CGAL/alpha_wrap_3.h>
 #include <tbb/parallel_for.h>
 
@@ -15,12 +13,13 @@
 #include <vector>
 
 #include "mesh/cgal_ops.hpp"
+#include "mesh/cgal_surface_mesh.hpp"
 
 namespace mesh::detail {
 
 namespace {
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Point = K::Point_3;
+using K = CgalKernel;
+using Point = CgalPoint;
 using Triangle3 = K::Triangle_3;
 using TriangleIt = std::vector<Triangle3>::const_iterator;
 using Primitive = CGAL::AABB_triangle_primitive<K, TriangleIt>;
@@ -108,23 +107,9 @@ TriMesh alpha_wrap(const TriMesh& soup, double alpha, double offset) {
   for (const Triangle& t : soup.triangles)
     faces.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
 
-  CGAL::Surface_mesh<Point> wrap;
+  SurfaceMesh wrap;
   CGAL::alpha_wrap_3(points, faces, alpha, offset, wrap);
-
-  TriMesh out;
-  std::vector<int> index(wrap.number_of_vertices() + wrap.number_of_removed_vertices(), -1);
-  for (auto v : wrap.vertices()) {
-    index[v.idx()] = int(out.vertices.size());
-    const Point& p = wrap.point(v);
-    out.vertices.emplace_back(p.x(), p.y(), p.z());
-  }
-  for (auto f : wrap.faces()) {
-    Triangle t{};
-    int k = 0;
-    for (auto v : CGAL::vertices_around_face(wrap.halfedge(f), wrap)) t[k++] = index[v.idx()];
-    out.triangles.push_back(t);
-  }
-  return out;
+  return to_trimesh(wrap);
 }
 
 FarthestSample farthest_sample(const TriMesh& from, const TriMesh& to, const SampleFilter& counts,
