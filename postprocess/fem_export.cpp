@@ -159,7 +159,7 @@ BoundarySets boundary_sets(const mesh::TetMesh& m, double table_z) {
       ++it->second[3];
     }
   // Mesh_3 places the nodes of a flat face by its constructions, not exactly in its plane: on
-  // the turbine blade's cut one of 3,557 nodes of the table lay 1.85 nm above the rest (1.2e-8
+  // the turbine blade's cut one node of the table lay 1.85 nm above the other 3,556 (1.2e-8
   // of the coordinates), which took the plane with it and left the punch no face. A millionth
   // of the coordinates' size is far beyond that and far below any feature an element resolves.
   double size = 0;
