@@ -3,9 +3,12 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <random>
+#include <vector>
 
 #include "mesh/geometry.hpp"
 #include "mesh/versions.hpp"
@@ -43,39 +46,78 @@ struct ExactSurface::Impl {
     return false;
   }
 
-  // Faces the ray from `origin` crosses: all of them, or with `signed_by_face` those it leaves
-  // through (along their outward normal) minus those it enters through.
-  int crossings(const Vec3& origin, const Vec3& direction, bool signed_by_face = false) const {
+  // Faces the ray from `origin` crosses (parity is all a closed mesh needs).
+  int crossings(const Vec3& origin, const Vec3& direction) const {
     int count = 0;
     float tnear = 0.0f;
-    const Vec3 o = origin - centre;
     for (int guard = 0; guard < 100000; ++guard) {
-      RTCRayHit rh{};
-      rh.ray.org_x = float(o.x());
-      rh.ray.org_y = float(o.y());
-      rh.ray.org_z = float(o.z());
-      rh.ray.dir_x = float(direction.x());
-      rh.ray.dir_y = float(direction.y());
-      rh.ray.dir_z = float(direction.z());
-      rh.ray.tnear = tnear;
-      rh.ray.tfar = std::numeric_limits<float>::infinity();
-      rh.ray.mask = 0xFFFFFFFFu;
-      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      RTCRayHit rh = ray_from(origin, direction, tnear);
       RTCIntersectContext context;
       rtcInitIntersectContext(&context);
       rtcIntersect1(scene, &context, &rh);
       if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
-      if (signed_by_face) {
-        const Triangle& t = mesh.triangles[rh.hit.primID];
-        const Vec3 outward = (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
-        count += outward.dot(direction) > 0 ? 1 : -1;
-      } else {
-        ++count;
-      }
+      ++count;
       tnear = std::nextafter(rh.ray.tfar, std::numeric_limits<float>::infinity()) +
               1e-7f * std::max(1.0f, rh.ray.tfar);
     }
     return count;
+  }
+
+  RTCRayHit ray_from(const Vec3& origin, const Vec3& direction, float tnear) const {
+    const Vec3 o = origin - centre;
+    RTCRayHit rh{};
+    rh.ray.org_x = float(o.x());
+    rh.ray.org_y = float(o.y());
+    rh.ray.org_z = float(o.z());
+    rh.ray.dir_x = float(direction.x());
+    rh.ray.dir_y = float(direction.y());
+    rh.ray.dir_z = float(direction.z());
+    rh.ray.tnear = tnear;
+    rh.ray.tfar = std::numeric_limits<float>::infinity();
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    return rh;
+  }
+
+  // Every face along a ray, coincident ones included: a filter that records each hit and rejects
+  // it, so that traversal goes on (Embree's idiom for all hits). Stepping past the nearest hit
+  // instead skipped a face lying where another one already was, as overlapping shells do.
+  struct AllHits {
+    RTCIntersectContext context;  // first: Embree passes the filter a pointer to it
+    std::vector<unsigned> faces;
+    bool grazes_an_edge = false;
+  };
+
+  static void record_hit(const RTCFilterFunctionNArguments* args) {
+    auto* hits = reinterpret_cast<AllHits*>(args->context);
+    const float u = RTCHitN_u(args->hit, args->N, 0), v = RTCHitN_v(args->hit, args->N, 0);
+    // Within 1e-5 of an edge in float coordinates a crossing may be reported by both faces
+    // beside it or by neither.
+    constexpr float edge = 1e-5f;
+    if (u < edge || v < edge || 1.0f - u - v < edge) hits->grazes_an_edge = true;
+    hits->faces.push_back(RTCHitN_primID(args->hit, args->N, 0));
+    args->valid[0] = 0;
+  }
+
+  // The faces the ray leaves through (along their outward normal) minus those it enters
+  // through, counting every face once (spatial splits may report one twice); nullopt when the ray
+  // passes within float rounding of an edge, where that count is not to be trusted.
+  std::optional<int> winding_along(const Vec3& origin, const Vec3& direction) const {
+    AllHits hits;
+    rtcInitIntersectContext(&hits.context);
+    hits.context.filter = &record_hit;
+    RTCRayHit rh = ray_from(origin, direction, 0.0f);
+    rtcIntersect1(scene, &hits.context, &rh);
+    if (hits.grazes_an_edge) return std::nullopt;
+    std::sort(hits.faces.begin(), hits.faces.end());
+    hits.faces.erase(std::unique(hits.faces.begin(), hits.faces.end()), hits.faces.end());
+    int winding = 0;
+    for (const unsigned f : hits.faces) {
+      const Triangle& t = mesh.triangles[f];
+      const Vec3 outward = (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
+      winding += outward.dot(direction) > 0 ? 1 : -1;
+    }
+    return winding;
   }
 };
 
@@ -91,6 +133,7 @@ ExactSurface::ExactSurface(const TriMesh& mesh) : impl_(std::make_unique<Impl>()
   s.device = rtcNewDevice(nullptr);
   s.scene = rtcNewScene(s.device);
   rtcSetSceneBuildQuality(s.scene, RTC_BUILD_QUALITY_HIGH);
+  rtcSetSceneFlags(s.scene, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);  // for Impl::winding_along
   RTCGeometry geometry = rtcNewGeometry(s.device, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
       geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.vertices.size()));
@@ -145,9 +188,14 @@ bool ExactSurface::inside_by_ray_majority(const Vec3& p, int rays) const {
   std::mt19937_64 random(7);
   std::normal_distribution<double> normal;
   int votes = 0;
-  for (int r = 0; r < rays; ++r) {
+  for (int r = 0, draws = 0; r < rays; ++draws) {
     const Vec3 direction = Vec3(normal(random), normal(random), normal(random)).normalized();
-    votes += impl_->crossings(p, direction, true) > 0;
+    const std::optional<int> winding = impl_->winding_along(p, direction);
+    // A ray along an edge is drawn again; after 100 such draws the point lies on the surface
+    // itself, where neither answer is wrong.
+    if (!winding && draws < 100) continue;
+    votes += winding.value_or(0) > 0;
+    ++r;
   }
   return 2 * votes > rays;
 }
