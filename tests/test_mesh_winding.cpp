@@ -60,7 +60,8 @@ TEST(WindingNumber, MeasuresTheSolidAngleOfAnOpenSurface) {
 // against the file's winding number). Counting every hit, the majority of 7 rays is the winding
 // number's verdict at every point.
 TEST(ExactSurface, RayMajorityCountsTheCoincidentFacesOfTouchingShells) {
-  const mesh::TriMesh stack = test::joined(mesh::box_solid(mm(0, 0, 0), mm(10, 10, 10)), mesh::box_solid(mm(0, 0, 10), mm(10, 10, 11)));
+  const mesh::TriMesh stack =
+      test::joined(mesh::box_solid(mm(0, 0, 0), mm(10, 10, 10)), mesh::box_solid(mm(0, 0, 10), mm(10, 10, 11)));
   const mesh::ExactSurface rays(stack);
   std::mt19937_64 random(3);
   std::uniform_real_distribution<double> across(-1e-3, 11e-3), up(9e-3, 12e-3);

@@ -10,6 +10,7 @@
 #include "mesh/shapes.hpp"
 #include "mesh/tool.hpp"
 #include "mesh/verify.hpp"
+#include "meshes.hpp"
 #include "support.hpp"
 
 using mesh::Vec3;
@@ -134,12 +135,10 @@ TEST(Sdf, ASealedVoidThinnerThanAVoxelKeepsTheBandAroundIt) {
   const double h = 1e-3;
   for (const double thickness : {0.15, 0.45, 0.7}) {
     for (const double offset : {0.0, 0.37}) {
-      mesh::TriMesh solid = mesh::box_solid(Vec3(0, 0, 0), Vec3(10e-3, 10e-3, 10e-3));
-      mesh::TriMesh void_ = mesh::box_solid(Vec3(2e-3, 2e-3, (5 + offset) * h), Vec3(8e-3, 8e-3, (5 + offset + thickness) * h));
-      for (auto& t : void_.triangles) std::swap(t[1], t[2]);  // facing into the void
-      const int base = int(solid.vertices.size());
-      solid.vertices.insert(solid.vertices.end(), void_.vertices.begin(), void_.vertices.end());
-      for (const auto& t : void_.triangles) solid.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+      const mesh::TriMesh void_faces =
+          mesh::box_solid(Vec3(2e-3, 2e-3, (5 + offset) * h), Vec3(8e-3, 8e-3, (5 + offset + thickness) * h));
+      const mesh::TriMesh solid =
+          test::joined(mesh::box_solid(Vec3(0, 0, 0), Vec3(10e-3, 10e-3, 10e-3)), test::reversed(void_faces));
       const mesh::SdfGrid sdf = mesh::build_sdf(solid, {h, 1.65 * h, 3 * h, false});
       const mesh::ExactSurface exact(solid);
       int checked = 0, wrong = 0;
