@@ -22,7 +22,7 @@ int run_sdf(const SdfCommand& c) {
 
   options.parting = mesh::parse_parting(c.parting, "--parting");
   const mesh::DieFile file = mesh::read_die_file(c.mesh, mesh::parse_unit_or_auto(c.units, "--units"),
-                                                 mesh::up_to_read(options), mesh::parting_to_read(options));
+                                                 mesh::up_to_read(options), mesh::parting_to_read(options), c.part);
   options.unit = file.unit;
   const mesh::PreparedDie die = mesh::prepare_die(file, options, std::nullopt);
   fmt::print("mesh {} ({} units{}: {})\n", die.source, mesh::unit_name(options.unit),

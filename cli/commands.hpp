@@ -18,6 +18,7 @@ struct SdfCommand {
   std::string role = "cavity";
   std::string up = "auto";  // the way a cavity's opening faces in the file
   std::string parting = "auto";  // where the table meets a cavity's part (die.parting)
+  int part = 0;                  // the body of an assembly's file (die.part); 0: all of it
   std::optional<double> voxel_mm;
   double grain_radius_mm = 0.5;
   double skin_mm = 0.25;

@@ -23,6 +23,10 @@ void add_sdf(CLI::App& root, app::SdfCommand& c, std::function<int()>& action) {
                   "Where the table meets a cavity's part: opening (its flat face), widest (its widest section) or auto "
                   "(die.parting)")
       ->capture_default_str();
+  cmd->add_option("--part", c.part,
+                  "For an assembly's file: the body the die is for, numbered by volume, largest first; 0: the whole file "
+                  "(die.part)")
+      ->capture_default_str();
   cmd->add_option("--role", c.role, "cavity (the part, open at the table), tool (the die body) or container (a closed vessel)")
       ->capture_default_str();
   cmd->add_option("--grain-radius", c.grain_radius_mm, "Largest grain radius [mm]")->capture_default_str();

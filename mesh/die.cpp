@@ -3,7 +3,9 @@
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
+#include <numeric>
 #include <nlohmann/json.hpp>
 
 #include "core/atomic_file.hpp"
@@ -157,21 +159,45 @@ DieOptions die_options_for_grains(double grain_radius_m, double skin_m, std::opt
   return o;
 }
 
-std::string die_cache_key(const std::string& file_sha256, Up up, std::optional<double> parting_z, const DieOptions& o) {
+std::string die_cache_key(const DieFile& file, std::optional<double> parting_z, const DieOptions& o) {
   std::string text = fmt::format(
       "format={};sha={};unit={};up={};role={};voxel={:.17g};ext={:.17g};int={:.17g};tol={:.17g};"
       "hole={:.17g};gap={:.17g};wrap={};margin={:.17g}",
-      cache_format, file_sha256, unit_name(o.unit), up_name(up), role_name(o.role), o.voxel_m, o.exterior_band_m,
+      cache_format, file.sha256, unit_name(o.unit), up_name(file.up), role_name(o.role), o.voxel_m, o.exterior_band_m,
       o.interior_band_m, o.repair.tolerance_m, o.repair.max_hole_m, o.repair.closable_gap_m, o.repair.allow_wrap,
       o.table_margin_m);
   if (parting_z) text += fmt::format(";parting={:.17g}", *parting_z);
+  if (file.part > 0) text += fmt::format(";part={}", file.part);
   if (o.table)
     text += fmt::format(";table={:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", o.table->x_min,
                         o.table->y_min, o.table->x_max, o.table->y_max, o.table->thickness);
   return diefill::sha256_hex(text);
 }
 
-DieFile read_die_file(const fs::path& path, std::optional<LengthUnit> unit, std::optional<Up> up, Parting parting) {
+TriMesh body_of_assembly(const TriMesh& mesh, int part, const std::string& source) {
+  std::vector<TriMesh> bodies = separate_bodies(mesh);
+  std::vector<double> volume(bodies.size());
+  std::transform(bodies.begin(), bodies.end(), volume.begin(), [](const TriMesh& b) { return std::abs(signed_volume(b)); });
+  std::vector<std::size_t> largest_first(bodies.size());
+  std::iota(largest_first.begin(), largest_first.end(), 0);
+  std::stable_sort(largest_first.begin(), largest_first.end(), [&](std::size_t a, std::size_t b) { return volume[a] > volume[b]; });
+  if (part >= 1 && std::size_t(part) <= bodies.size()) return std::move(bodies[largest_first[std::size_t(part) - 1]]);
+  std::string largest;
+  for (std::size_t k = 0; k < std::min<std::size_t>(5, bodies.size()); ++k) {
+    const Box box = bounding_box(bodies[largest_first[k]]);
+    const Vec3 size = 1e3 * box.size(), at = 1e3 * box.lo;
+    largest += fmt::format("{}{}: {:.4g} mm³, {:.3g} x {:.3g} x {:.3g} mm from ({:.4g}, {:.4g}, {:.4g})", k ? "; " : "", k + 1,
+                           volume[largest_first[k]] * 1e9, size.x(), size.y(), size.z(), at.x(), at.y(), at.z());
+  }
+  throw InputError(source, "part",
+                   fmt::format("part {} was asked for, and the file holds {} separate bodies (the largest: {})", part,
+                               bodies.size(), largest),
+                   fmt::format("Choose a part from 1 to {} (die.part, diefill sdf --part), numbered by volume, largest "
+                               "first, or 0 for the whole file",
+                               bodies.size()));
+}
+
+DieFile read_die_file(const fs::path& path, std::optional<LengthUnit> unit, std::optional<Up> up, Parting parting, int part) {
   DieFile file;
   file.source = path.string();
   file.name = path.stem().string();
@@ -179,7 +205,9 @@ DieFile read_die_file(const fs::path& path, std::optional<LengthUnit> unit, std:
   ImportResult imported = import_mesh(path, {unit});
   file.unit = imported.unit;
   file.unit_guessed = imported.unit_guessed;
-  file.mesh = std::move(imported.mesh);
+  // The unit is the file's, guessed from all of it; the opening is the part's own.
+  file.part = part;
+  file.mesh = part == 0 ? std::move(imported.mesh) : body_of_assembly(imported.mesh, part, file.source);
   file.sha256 = diefill::sha256_file(path);
   file.up_found = !up;
   const bool opens = up ? opening_area(file.mesh, *up) > 0 : has_flat_extreme(file.mesh);
@@ -218,7 +246,8 @@ PreparedDie prepare_die(const DieFile& file, const DieOptions& options, const st
   out.parting_z = options.role == WallRole::cavity ? file.parting_z : std::nullopt;
   out.unit = file.unit;
   out.unit_guessed = file.unit_guessed;
-  out.cache_key = die_cache_key(out.sha256, file.up, out.parting_z, options);
+  out.part = file.part;
+  out.cache_key = die_cache_key(file, out.parting_z, options);
 
   if (cache_dir) {
     const fs::path base = *cache_dir / out.cache_key;

@@ -50,6 +50,7 @@ struct PreparedDie {
   bool unit_guessed = false;         // from its size, not given
   Up up;               // the way its opening faced in the file (now +z)
   bool up_found = false;  // found by looking, not given
+  int part = 0;        // the body of the file it is for (DieFile); 0: the whole file
   std::optional<double> parting_z;  // [m] where the table cuts a part with no flat opening (DieFile)
   MeshReport before, after;          // checks before and after repair
   std::vector<std::string> actions;  // repair steps taken
@@ -78,14 +79,25 @@ struct DieFile {
   // `parting` asks for it; the part above it is left to the upper punch. Unset: the table lies at
   // the part's flat top face.
   std::optional<double> parting_z;
-  TriMesh mesh;        // [m], turned, whole
+  // The body of an assembly's file the die is for (`die.part`, body_of_assembly): 1 the largest
+  // by volume; 0 the whole file.
+  int part = 0;
+  TriMesh mesh;        // [m], turned: the whole file, or the part chosen
 };
-// Reads the file in `unit` (unset: guessed from its size, with a warning) and turns it so that
-// its opening faces +z (`up` unset: find_opening, or lying_flat for a part with no flat face that
-// `parting` lets be cut). Throws InputError for a missing, empty or unreadable file, and for a
-// part with no flat face when `parting` is Parting::opening.
+// Reads the file in `unit` (unset: guessed from its size, with a warning), keeps its body `part`
+// (0: all of it) and turns it so that its opening faces +z (`up` unset: find_opening, or
+// lying_flat for a part with no flat face that `parting` lets be cut). Throws InputError for a
+// missing, empty or unreadable file, a part the file does not hold, and a part with no flat face
+// when `parting` is Parting::opening.
 DieFile read_die_file(const std::filesystem::path& path, std::optional<LengthUnit> unit, std::optional<Up> up = Up{},
-                      Parting parting = Parting::automatic);
+                      Parting parting = Parting::automatic, int part = 0);
+
+// The `part`-th largest body of an assembly's file by enclosed volume (1: the largest; ties in the
+// file's order), its bodies being the pieces that share no vertex (separate_bodies). A die forms
+// one part; an assembly's parts stand apart by clearances no die wall is as thin as (README,
+// "Assemblies"). Throws InputError naming `source`, the bodies and the largest ones when the file
+// holds fewer than `part`.
+TriMesh body_of_assembly(const TriMesh& mesh, int part, const std::string& source);
 
 // The `up` to read a die's file with: the options' own, or for a cavity unset (its opening is
 // found); a tool or a container is not turned.
@@ -105,7 +117,7 @@ PreparedDie prepare_die(const std::filesystem::path& path, const DieOptions& opt
 DieOptions die_options_for_grains(double grain_radius_m, double skin_m,
                                   std::optional<double> voxel_m = std::nullopt);
 
-// The cache key: the file's bytes and every parameter that changes the result.
-std::string die_cache_key(const std::string& file_sha256, Up up, std::optional<double> parting_z, const DieOptions& options);
+// The cache key: the file's bytes, how it was read and every parameter that changes the result.
+std::string die_cache_key(const DieFile& file, std::optional<double> parting_z, const DieOptions& options);
 
 }  // namespace mesh

@@ -220,9 +220,14 @@ std::optional<TriMesh> winding_number_solid(const SurfaceMesh& sm, const MeshRep
   if (solid.moved_m > options.tolerance_m)
     return refused(fmt::format("move the surface by {}", mm(solid.moved_m)), solid.moved_most_at,
                    !solid.moved_across_thin_solid ? ""
-                   : fmt::format(", where {} is thinner than {} and the cells join what it parts",
+                   : fmt::format(", where {} is thinner than {} and the cells join what it parts{}",
                                  options.free_space_inside ? "the die's wall between two parts of the cavity" : "the solid",
-                                 mm(options.closable_gap_m)));
+                                 mm(options.closable_gap_m),
+                                 options.free_space_inside && before.shells > 1
+                                     ? fmt::format(" (if its {} shells are an assembly's parts, each needs a die of its "
+                                                   "own: die.part, or diefill sdf --part, chooses one)",
+                                                   before.shells)
+                                     : ""));
   result.actions.push_back(fmt::format(
       "{}: re-meshed as the solid its winding number encloses (cells of {}; ambiguous volume {:.4g} mm³, "
       "{:.3g} % of the solid)",

@@ -96,6 +96,7 @@ nlohmann::json report_json(const FillRecord& r, const nlohmann::json& fill, cons
         {"up_in_file", mesh::up_name(die.up)},
         {"up_found", die.up_found},
         {"parting", die.parting_z ? "widest section" : "flat opening"},
+        {"part", die.part},
         {"cavity_volume_m3", die.after.volume_m3},
         {"triangles", die.before.triangles},
         {"repaired", !die.actions.empty()},

@@ -34,7 +34,7 @@ DieSource read_die(const PipelineScene& scene, const std::filesystem::path& die_
     throw diefill::InputError(die_mesh.string(), "die.role", "the pipeline fills a cavity", "Give the cavity mesh (role \"cavity\")");
   DieSource die;
   die.file = mesh::read_die_file(die_mesh, mesh::parse_unit_or_auto(scene.die_units, "die.units"), mesh::parse_up(scene.die_up, "die.up"),
-                                 mesh::parse_parting(scene.die_parting, "die.parting"));
+                                 mesh::parse_parting(scene.die_parting, "die.parting"), scene.die_part);
   if (die.file.up_found && die.file.up != mesh::Up{} && !die.file.parting_z)
     diefill::log::warn("{}: its opening (a flat face at its extreme) faces {} in the file; turned so that it faces up. "
                        "Set die.up to choose another way",

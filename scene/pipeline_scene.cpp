@@ -67,6 +67,10 @@ KeyTable<P> make_pipeline_keys() {
            "rest); auto: opening when the part has a flat face at an extreme, else widest with the part lying flat "
            "(up: the axis of its largest outline)",
            &P::die_parting),
+      integer("die", "part", {0, 1e6}, die,
+              "for a file that holds an assembly (bodies that share no vertex): the body the die is for, numbered by "
+              "enclosed volume, largest first; 0: the whole file as one part",
+              &P::die_part),
       text("die", "role", KeyType::choice, {"cavity"}, die,
            "the mesh is the part's shape, open at the die table (its highest z); `diefill sdf --role` takes tools too",
            &P::die_role),

@@ -217,6 +217,42 @@ TEST(Orientation, ADieFileOnItsSideIsReadFacingUp) {
   EXPECT_LT((a.lo - b.lo).norm() + (a.hi - b.hi).norm(), 1e-8);
 }
 
+// An assembly's file (README, "Assemblies"): a 4 mm cube, a 20 x 20 x 8 mm plate and a second
+// cube, bodies that share no vertex. die.part keeps one, numbered by volume, largest first, the
+// file's order breaking the cubes' tie; a part the file does not hold is refused naming the count
+// and the largest; each part is its own cache entry.
+TEST(Assembly, APartIsOneBodyOfTheFileNumberedByVolume) {
+  const mesh::TriMesh cube = test::box_mm(0, 4);
+  const mesh::TriMesh plate = mesh::box_solid(Vec3(10e-3, 0, 0), Vec3(30e-3, 20e-3, 8e-3));
+  const mesh::TriMesh second_cube = mesh::box_solid(Vec3(40e-3, 0, 0), Vec3(44e-3, 4e-3, 4e-3));
+  test::TempDir dir;
+  const auto path = dir / "assembly.stl";
+  test::write_text(path, test::ascii_stl(test::joined(test::joined(cube, plate), second_cube)));
+  const auto part = [&](int k) {
+    return mesh::read_die_file(path, mesh::LengthUnit::mm, mesh::Up{}, mesh::Parting::automatic, k);
+  };
+  const mesh::DieFile whole = part(0), largest = part(1), second = part(2), third = part(3);
+  EXPECT_NEAR(mesh::signed_volume(whole.mesh), 3200e-9 + 2 * 64e-9, 1e-15);
+  EXPECT_EQ(whole.mesh.triangles.size(), 36u);
+  EXPECT_NEAR(mesh::signed_volume(largest.mesh), 3200e-9, 1e-15);
+  EXPECT_NEAR(mesh::bounding_box(largest.mesh).lo.x(), 10e-3, 1e-9);
+  EXPECT_NEAR(mesh::signed_volume(second.mesh), 64e-9, 1e-16);
+  EXPECT_NEAR(mesh::bounding_box(second.mesh).lo.x(), 0, 1e-9);
+  EXPECT_NEAR(mesh::bounding_box(third.mesh).lo.x(), 40e-3, 1e-9);
+  EXPECT_EQ(third.part, 3);
+  try {
+    part(4);
+    ADD_FAILURE() << "the file holds three bodies";
+  } catch (const diefill::InputError& e) {
+    const std::string what = e.what();
+    for (const char* named : {"assembly.stl", "part 4", "3 separate bodies", "1: 3200 mm³", "from 1 to 3"})
+      EXPECT_NE(what.find(named), std::string::npos) << named << " in: " << what;
+  }
+  const mesh::DieOptions options = mesh::die_options_for_grains(1e-3, 0.5e-3, 0.5e-3);
+  EXPECT_NE(mesh::die_cache_key(largest, std::nullopt, options), mesh::die_cache_key(second, std::nullopt, options));
+  EXPECT_NE(mesh::die_cache_key(whole, std::nullopt, options), mesh::die_cache_key(largest, std::nullopt, options));
+}
+
 TEST(Import, ReadsFormatsAndWeldsToTheSameSolid) {
   test::TempDir dir;
   const mesh::TriMesh box = test::box_mm(0, 10);

@@ -23,6 +23,7 @@ struct SharedDie {
   double voxel_mm = 0;
   // As what it is tested: a tool (the solid itself) unless it is a die the pipeline fills.
   mesh::WallRole role = mesh::WallRole::tool;
+  int part = 0;  // one body of an assembly's file (die.part); 0: the whole file
 };
 
 // Why each refused mesh is refused, in the words the error must contain.
@@ -46,6 +47,9 @@ const SharedDie shared_dies[] = {
     // At voxels of 0.9 mm it loads as a tool (472 s) and is refused as a cavity (README, "Shared
     // dies through the pipeline").
     {"toothed_pulley_hub_trimesh_cycloidal.ply", mesh::LengthUnit::in, "non-manifold edges"},
+    // One part of it, as a die is for one part (README, "Assemblies"): its 4th largest body, a
+    // cycloid disc (lobed, 43 mm across, 3.2 mm thick, with bores), as the cavity it would be.
+    {"toothed_pulley_hub_trimesh_cycloidal.ply", mesh::LengthUnit::in, nullptr, 0.15, mesh::WallRole::cavity, 4},
     // 24 crossing shells: as a tool its winding-number solid closes the gaps between them that
     // no grain a voxel across touches, and it loads (as a cavity it has no flat opening).
     {"broken/assimp_3DSMaxExport.stl", mesh::LengthUnit::mm, nullptr},
@@ -71,8 +75,8 @@ void PrintTo(const SharedDie& d, std::ostream* os) { *os << d.file; }
 void expect_sign_of_the_file(const std::filesystem::path& path, mesh::LengthUnit unit, mesh::WallRole role,
                              const mesh::PreparedDie& die, double voxel) {
   const bool cavity = role == mesh::WallRole::cavity;
-  const mesh::TriMesh file =
-      cavity ? mesh::read_die_file(path, unit, die.up).mesh : mesh::import_mesh(path, {unit}).mesh;
+  const mesh::TriMesh file = cavity ? mesh::read_die_file(path, unit, die.up, mesh::Parting::automatic, die.part).mesh
+                                    : mesh::import_mesh(path, {unit}).mesh;
   const mesh::ExactSurface rays(file);
   const mesh::Box box = mesh::bounding_box(file);
   const mesh::Vec3 margin = 0.1 * box.size();
@@ -117,7 +121,8 @@ TEST_P(SharedDieMesh, LoadsAndPassesTheSignCheckOrNamesItsDefect) {
   o.unit = d.unit;
   o.role = d.role;
   if (d.defect == nullptr) {
-    const mesh::PreparedDie sized = mesh::prepare_die(path, o, std::nullopt);
+    const mesh::PreparedDie sized = mesh::prepare_die(
+        mesh::read_die_file(path, o.unit, mesh::up_to_read(o), mesh::parting_to_read(o), d.part), o, std::nullopt);
     const mesh::ExactSurface exact(sized.solid);
     const mesh::SdfVerification v =
         mesh::verify_sdf(sized.sdf.wall_field(sized.solid), sized.solid, exact, 3000, 3);
@@ -147,6 +152,7 @@ TEST_P(SharedDieMesh, LoadsAndPassesTheSignCheckOrNamesItsDefect) {
 INSTANTIATE_TEST_SUITE_P(All, SharedDieMesh, ::testing::ValuesIn(shared_dies),
                          [](const ::testing::TestParamInfo<SharedDie>& param_info) {
                            std::string name = param_info.param.file;
+                           if (param_info.param.part > 0) name += "_part" + std::to_string(param_info.param.part);
                            for (char& c : name)
                              if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
                            return name;
