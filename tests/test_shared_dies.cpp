@@ -48,7 +48,7 @@ const SharedDie shared_dies[] = {
     // dies through the pipeline").
     {"toothed_pulley_hub_trimesh_cycloidal.ply", mesh::LengthUnit::in, "non-manifold edges"},
     // One part of it, as a die is for one part (README, "Assemblies"): its 4th largest body, a
-    // cycloid disc (lobed, 43 mm across, 3.2 mm thick, with bores), as the cavity it would be.
+    // cycloid disc (43.4 mm across, 3.18 mm thick, lobed, 7 bores), as the cavity it would be.
     {"toothed_pulley_hub_trimesh_cycloidal.ply", mesh::LengthUnit::in, nullptr, 0.15, mesh::WallRole::cavity, 4},
     // 24 crossing shells: as a tool its winding-number solid closes the gaps between them that
     // no grain a voxel across touches, and it loads (as a cavity it has no flat opening).
