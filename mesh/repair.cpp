@@ -224,9 +224,8 @@ std::optional<TriMesh> winding_number_solid(const SurfaceMesh& sm, const MeshRep
                                  options.free_space_inside ? "the die's wall between two parts of the cavity" : "the solid",
                                  mm(options.closable_gap_m),
                                  options.free_space_inside && before.shells > 1
-                                     ? fmt::format(" (if its {} shells are an assembly's parts, each needs a die of its "
-                                                   "own: die.part, or diefill sdf --part, chooses one)",
-                                                   before.shells)
+                                     ? " (if its separate shells are an assembly's parts, each needs a die of its own: "
+                                       "die.part, or diefill sdf --part, chooses one)"
                                      : ""));
   result.actions.push_back(fmt::format(
       "{}: re-meshed as the solid its winding number encloses (cells of {}; ambiguous volume {:.4g} mm³, "
