@@ -290,19 +290,12 @@ TriMesh alpha_wrapped(const TriMesh& input, const MeshReport& before, const Repa
   return wrapped;
 }
 
-}  // namespace
-
-RepairResult repair(const TriMesh& input, const RepairOptions& options, const std::string& source) {
-  RepairResult result;
-  diefill::Stopwatch clock;
-  result.before = inspect(input);
-  diefill::log::debug("repair: inspected in {:.2f} s", clock.seconds());
-  const MeshReport& before = result.before;
+// A mesh no repair can read as one solid: too few triangles, or a surface inside out.
+void refuse_what_no_repair_reads(const MeshReport& before, const std::string& source) {
   if (before.triangles < 4)
     throw InputError(source, "triangles",
                      fmt::format("{} triangle(s) cannot enclose a solid", before.triangles),
                      "Export the closed solid of the part, not a single face");
-
   // A consistently oriented closed surface whose faces all point inward bounds the space around
   // a solid. Whether the file means that solid or its complement (a cavity exported as the tool
   // around it) cannot be told from the file, and the two give opposite dies: refuse rather than
@@ -315,7 +308,24 @@ RepairResult repair(const TriMesh& input, const RepairOptions& options, const st
                                  before.volume_m3 * 1e9),
                      "Reverse the faces' winding in CAD or a mesh tool (MeshLab: Filters > Normals > "
                      "Invert Faces Orientation) and export it again");
+}
 
+bool same_mesh(const TriMesh& a, const TriMesh& b) { return a.vertices == b.vertices && a.triangles == b.triangles; }
+
+// The surface between repair's steps.
+struct Repairing {
+  TriMesh mesh;
+  SurfaceMesh sm;  // the same surface in CGAL's form
+  bool closed = false;
+  bool self_intersecting = false;
+  double largest_open_hole = 0.0;
+  bool geometry_changed = false;         // holes filled, re-meshed or wrapped: measured against the input
+  std::optional<double> union_moved_m;   // set when the shells were united
+  std::optional<double> welded_moved_m;  // set when close vertices were welded
+};
+
+// Steps 1 to 3 of repair, on the soup and its surface: duplicates, orientation, stitching, holes.
+Repairing repaired_surface(const TriMesh& input, const RepairOptions& options, RepairResult& result) {
   // 1. Soup level: merge duplicate points, drop triangles with repeated vertices, and keep one
   //    of each duplicated triangle (either winding: double-sided surfaces become single).
   auto [points, polygons] = soup_of(input);
@@ -328,155 +338,178 @@ RepairResult repair(const TriMesh& input, const RepairOptions& options, const st
   //    that only failed to share vertices.
   if (!PMP::orient_polygon_soup(points, polygons))
     result.actions.push_back("split non-manifold vertices to orient the surface");
-  SurfaceMesh sm;
-  PMP::polygon_soup_to_polygon_mesh(points, polygons, sm);
-  const std::size_t borders_before = before.boundary_edges;
-  PMP::stitch_borders(sm);
-  PMP::remove_degenerate_faces(sm);
-  sm.collect_garbage();
+  Repairing r;
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, r.sm);
+  PMP::stitch_borders(r.sm);
+  PMP::remove_degenerate_faces(r.sm);
+  r.sm.collect_garbage();
 
   // 3. Fill holes up to the allowed diameter.
   std::vector<SurfaceMesh::Halfedge_index> cycles;
-  PMP::extract_boundary_cycles(sm, std::back_inserter(cycles));
-  double largest_open_hole = 0.0;
+  PMP::extract_boundary_cycles(r.sm, std::back_inserter(cycles));
   std::size_t open_holes = 0;
   for (auto h : cycles) {
-    const double diameter = diameter_of_cycle(sm, h);
+    const double diameter = diameter_of_cycle(r.sm, h);
     if (diameter <= options.max_hole_m) {
       std::vector<SurfaceMesh::Face_index> patch;
-      PMP::triangulate_and_refine_hole(sm, h, std::back_inserter(patch),
-                                       CGAL::Emptyset_iterator());
+      PMP::triangulate_and_refine_hole(r.sm, h, std::back_inserter(patch), CGAL::Emptyset_iterator());
       ++result.holes_filled;
     } else {
       ++open_holes;
-      largest_open_hole = std::max(largest_open_hole, diameter);
+      r.largest_open_hole = std::max(r.largest_open_hole, diameter);
     }
   }
   if (result.holes_filled > 0)
     result.actions.push_back(fmt::format("filled {} hole(s) up to {} across",
                                          result.holes_filled, mm(options.max_hole_m)));
-  if (borders_before > 0 && cycles.size() == 0)
+  if (result.before.boundary_edges > 0 && cycles.size() == 0)
     result.actions.push_back("stitched borders that did not share vertices");
 
-  diefill::log::debug("repair: soup, orientation, stitching and holes done at {:.2f} s", clock.seconds());
-  TriMesh repaired = to_trimesh(sm);
-  const bool closed = CGAL::is_closed(sm) && open_holes == 0;
+  r.mesh = to_trimesh(r.sm);
+  r.closed = CGAL::is_closed(r.sm) && open_holes == 0;
   // The crossing test is most of the inspection (13 s on a million triangles): a mesh the soup
   // level left as it was is not tested again, nor inspected again at the end.
-  const auto unchanged = [&input](const TriMesh& m) { return m.vertices == input.vertices && m.triangles == input.triangles; };
-  bool self_intersecting =
-      closed && (unchanged(repaired) ? before.self_intersections : detail::count_self_intersections(repaired)) > 0;
-  bool geometry_changed = result.holes_filled > 0;
-  std::optional<double> union_moved_m;  // set when the shells were united
-  std::optional<double> welded_moved_m;  // set when close vertices were welded
+  r.self_intersecting =
+      r.closed && (same_mesh(r.mesh, input) ? result.before.self_intersections : detail::count_self_intersections(r.mesh)) > 0;
+  r.geometry_changed = result.holes_filled > 0;
+  return r;
+}
 
-  // 4. A closed surface folded through itself by less than a thousandth to a tenth of the
-  //    tolerance: its close vertices welded (the folds of a seam close; moves measured below).
-  if (closed && self_intersecting) {
-    if (std::optional<SmallFoldsWelded> welded = weld_small_folds(repaired, options.tolerance_m)) {
-      result.actions.push_back(fmt::format("welded {} vertices closer than {} to others, removing {} pairs of "
-                                           "intersecting triangles (folds smaller than that), moving them by up to {}",
-                                           welded->merged, mm(welded->distance_m), before.self_intersections,
-                                           mm(welded->moved_m)));
-      repaired = std::move(welded->mesh);
-      sm = polygon_mesh_of(repaired);
-      self_intersecting = false;
-      welded_moved_m = welded->moved_m;
-    }
-  }
+// 4. A closed surface folded through itself by less than a thousandth to a tenth of the
+//    tolerance: its close vertices welded (the folds of a seam close; moves measured below).
+void weld_folds_of_a_seam(Repairing& r, const RepairOptions& options, RepairResult& result) {
+  std::optional<SmallFoldsWelded> welded = weld_small_folds(r.mesh, options.tolerance_m);
+  if (!welded) return;
+  result.actions.push_back(fmt::format("welded {} vertices closer than {} to others, removing {} pairs of "
+                                       "intersecting triangles (folds smaller than that), moving them by up to {}",
+                                       welded->merged, mm(welded->distance_m), result.before.self_intersections,
+                                       mm(welded->moved_m)));
+  r.mesh = std::move(welded->mesh);
+  r.sm = polygon_mesh_of(r.mesh);
+  r.self_intersecting = false;
+  r.welded_moved_m = welded->moved_m;
+}
 
-  // 5. Closed shells that intersect each other or themselves (gears in mesh, engravings on a
-  //    disc, a folded scan): the union of the solids they enclose. The union itself moves no
-  //    surface that stays on the outside; removing a fold does, and is measured.
-  if (closed && self_intersecting) {
-    detail::UnionResult united;
-    // A fold removed by moving the surface beyond the tolerance is left to the winding number.
-    if (detail::union_of_shells(repaired, united) && united.moved_m <= options.tolerance_m) {
-      if (united.empty_shells > 0)
-        result.actions.push_back(fmt::format("dropped {} shell(s) enclosing no volume", united.empty_shells));
-      result.actions.push_back(fmt::format("united {} intersecting shells (exact corefinement)", before.shells));
-      if (united.unfolded_shells > 0)
-        result.actions.push_back(fmt::format("re-meshed {} shell(s) folded through themselves ({} pairs of "
-                                             "intersecting triangles in the input), moving them by up to {}",
-                                             united.unfolded_shells, before.self_intersections, mm(united.moved_m)));
-      repaired = std::move(united.mesh);
-      union_moved_m = united.moved_m;
-      sm = polygon_mesh_of(repaired);
-      self_intersecting = false;
-      diefill::log::debug("repair: union done at {:.2f} s", clock.seconds());
-    }
-  }
+// 5. Closed shells that intersect each other or themselves (gears in mesh, engravings on a
+//    disc, a folded scan): the union of the solids they enclose. The union itself moves no
+//    surface that stays on the outside; removing a fold does, and is measured.
+void unite_intersecting_shells(Repairing& r, const RepairOptions& options, RepairResult& result) {
+  detail::UnionResult united;
+  // A fold removed by moving the surface beyond the tolerance is left to the winding number.
+  if (!detail::union_of_shells(r.mesh, united) || united.moved_m > options.tolerance_m) return;
+  if (united.empty_shells > 0)
+    result.actions.push_back(fmt::format("dropped {} shell(s) enclosing no volume", united.empty_shells));
+  result.actions.push_back(fmt::format("united {} intersecting shells (exact corefinement)", result.before.shells));
+  if (united.unfolded_shells > 0)
+    result.actions.push_back(fmt::format("re-meshed {} shell(s) folded through themselves ({} pairs of "
+                                         "intersecting triangles in the input), moving them by up to {}",
+                                         united.unfolded_shells, result.before.self_intersections, mm(united.moved_m)));
+  r.mesh = std::move(united.mesh);
+  r.union_moved_m = united.moved_m;
+  r.sm = polygon_mesh_of(r.mesh);
+  r.self_intersecting = false;
+}
 
-  if (closed && !self_intersecting) {
-    // 6. A closed surface: reject shells nested inside others (internal voids or duplicated
-    //    offset surfaces are no die), then orient every shell outward.
-    std::vector<std::size_t> nesting;
-    auto volume_ids = sm.add_property_map<SurfaceMesh::Face_index, std::size_t>("f:vid").first;
-    PMP::volume_connected_components(
-        sm, volume_ids,
-        CGAL::parameters::do_orientation_tests(false).nesting_levels(std::ref(nesting)));
-    const std::size_t nested = std::size_t(
-        std::count_if(nesting.begin(), nesting.end(), [](std::size_t l) { return l > 0; }));
-    if (nested > 0)
-      throw InputError(source, "shells",
-                       fmt::format("{} of {} closed shells lie inside another shell (an internal "
-                                   "void or a duplicated surface)",
-                                   nested, nesting.size()),
-                       "A die cavity or grain must be a solid without voids: remove the inner "
-                       "shell(s) in CAD");
-    const double volume_before = signed_volume(repaired);
-    PMP::orient_to_bound_a_volume(sm);
-    repaired = to_trimesh(sm);
-    if (signed_volume(repaired) != volume_before || before.inconsistent_edges > 0)
-      result.actions.push_back("oriented every shell outward");
-  } else {
-    // 7. Still open or self-intersecting: wrap it, unless the holes are beyond what a wrap
-    //    within the tolerance can close, or the wrap would be too fine to afford.
-    std::string defect = "the mesh is not a closed solid";
-    {
-      std::vector<std::string> parts;
-      if (!closed && before.boundary_edges > 0)
-        parts.push_back(fmt::format("{} boundary edges, largest remaining hole {} across",
-                                    before.boundary_edges, mm(largest_open_hole)));
-      if (before.non_manifold_edges > 0)
-        parts.push_back(fmt::format("{} non-manifold edges", before.non_manifold_edges));
-      if (const std::size_t crossing = unchanged(repaired) ? before.self_intersections : detail::count_self_intersections(repaired);
-          crossing > 0)
-        parts.push_back(fmt::format("{} pairs of intersecting triangles", crossing));
-      if (!parts.empty()) defect += " (" + fmt::format("{}", fmt::join(parts, "; ")) + ")";
-    }
-    if (std::optional<TriMesh> solid = winding_number_solid(sm, before, options, source, defect, result))
-      repaired = std::move(*solid);
-    else
-      repaired = alpha_wrapped(input, before, options, source, defect, closed, largest_open_hole, result);
-    geometry_changed = true;
-  }
+// 6. A closed surface: reject shells nested inside others (internal voids or duplicated offset
+//    surfaces are no die), then orient every shell outward.
+void orient_closed_shells(Repairing& r, const std::string& source, RepairResult& result) {
+  std::vector<std::size_t> nesting;
+  auto volume_ids = r.sm.add_property_map<SurfaceMesh::Face_index, std::size_t>("f:vid").first;
+  PMP::volume_connected_components(r.sm, volume_ids,
+                                   CGAL::parameters::do_orientation_tests(false).nesting_levels(std::ref(nesting)));
+  const std::size_t nested =
+      std::size_t(std::count_if(nesting.begin(), nesting.end(), [](std::size_t l) { return l > 0; }));
+  if (nested > 0)
+    throw InputError(source, "shells",
+                     fmt::format("{} of {} closed shells lie inside another shell (an internal "
+                                 "void or a duplicated surface)",
+                                 nested, nesting.size()),
+                     "A die cavity or grain must be a solid without voids: remove the inner "
+                     "shell(s) in CAD");
+  const double volume_before = signed_volume(r.mesh);
+  PMP::orient_to_bound_a_volume(r.sm);
+  r.mesh = to_trimesh(r.sm);
+  if (signed_volume(r.mesh) != volume_before || result.before.inconsistent_edges > 0)
+    result.actions.push_back("oriented every shell outward");
+}
 
-  diefill::log::debug("repair: closed-surface checks done at {:.2f} s", clock.seconds());
-  if (welded_moved_m && !geometry_changed) {
+// 7. Still open or self-intersecting: the solid its winding number encloses, else a wrap, unless
+//    the holes are beyond what a wrap within the tolerance can close, or either would be too fine
+//    to afford.
+void solid_of_a_broken_surface(Repairing& r, const TriMesh& input, const RepairOptions& options,
+                               const std::string& source, RepairResult& result) {
+  const MeshReport& before = result.before;
+  std::string defect = "the mesh is not a closed solid";
+  std::vector<std::string> parts;
+  if (!r.closed && before.boundary_edges > 0)
+    parts.push_back(fmt::format("{} boundary edges, largest remaining hole {} across", before.boundary_edges,
+                                mm(r.largest_open_hole)));
+  if (before.non_manifold_edges > 0) parts.push_back(fmt::format("{} non-manifold edges", before.non_manifold_edges));
+  if (const std::size_t crossing =
+          same_mesh(r.mesh, input) ? before.self_intersections : detail::count_self_intersections(r.mesh);
+      crossing > 0)
+    parts.push_back(fmt::format("{} pairs of intersecting triangles", crossing));
+  if (!parts.empty()) defect += " (" + fmt::format("{}", fmt::join(parts, "; ")) + ")";
+  if (std::optional<TriMesh> solid = winding_number_solid(r.sm, before, options, source, defect, result))
+    r.mesh = std::move(*solid);
+  else
+    r.mesh = alpha_wrapped(input, before, options, source, defect, r.closed, r.largest_open_hole, result);
+  r.geometry_changed = true;
+}
+
+// How far repair moved the existing surface and how wide a gap new surface spans; refused beyond
+// the tolerance.
+void measure_what_repair_moved(const Repairing& r, const TriMesh& input, const RepairOptions& options,
+                               const std::string& source, RepairResult& result) {
+  if (r.welded_moved_m && !r.geometry_changed) {
     // Every point of a welded triangle moved no farther than its corners did: no sampling (the
     // two samplings took 23 s of the planetary gear set's 23.6 s).
-    result.hausdorff_m = result.bridged_m = *welded_moved_m;
-  } else if (geometry_changed || union_moved_m) {
-    result.bridged_m = detail::max_distance(repaired, input);
-    // The union removes faces buried in the solid (a shell inside another, inner lobes), which
-    // measured against the result would read as moved by their depth: what it moved is what
-    // removing folds moved. Hole patches and a wrap are measured against the input.
-    result.hausdorff_m = union_moved_m ? *union_moved_m
-                         : result.winding_moved_m ? *result.winding_moved_m
-                                                  : detail::max_distance(input, repaired);
-    if (result.hausdorff_m > options.tolerance_m)
-      throw InputError(source, "tolerance",
-                       fmt::format("repair would move the surface by up to {} ({}), more than the "
-                                   "tolerance {}",
-                                   mm(result.hausdorff_m),
-                                   result.actions.empty() ? "repair" : result.actions.back(),
-                                   mm(options.tolerance_m)),
-                       "Repair the mesh in CAD, or raise the tolerance (--tolerance) if that "
-                       "change is acceptable");
+    result.hausdorff_m = result.bridged_m = *r.welded_moved_m;
+    return;
   }
-  result.after = unchanged(repaired) ? before : inspect(repaired);
-  result.mesh = std::move(repaired);
+  if (!r.geometry_changed && !r.union_moved_m) return;
+  result.bridged_m = detail::max_distance(r.mesh, input);
+  // The union removes faces buried in the solid (a shell inside another, inner lobes), which
+  // measured against the result would read as moved by their depth: what it moved is what
+  // removing folds moved. Hole patches and a wrap are measured against the input.
+  result.hausdorff_m = r.union_moved_m        ? *r.union_moved_m
+                       : result.winding_moved_m ? *result.winding_moved_m
+                                                : detail::max_distance(input, r.mesh);
+  if (result.hausdorff_m > options.tolerance_m)
+    throw InputError(source, "tolerance",
+                     fmt::format("repair would move the surface by up to {} ({}), more than the "
+                                 "tolerance {}",
+                                 mm(result.hausdorff_m), result.actions.empty() ? "repair" : result.actions.back(),
+                                 mm(options.tolerance_m)),
+                     "Repair the mesh in CAD, or raise the tolerance (--tolerance) if that "
+                     "change is acceptable");
+}
+
+}  // namespace
+
+RepairResult repair(const TriMesh& input, const RepairOptions& options, const std::string& source) {
+  RepairResult result;
+  diefill::Stopwatch clock;
+  result.before = inspect(input);
+  diefill::log::debug("repair: inspected in {:.2f} s", clock.seconds());
+  refuse_what_no_repair_reads(result.before, source);
+
+  Repairing r = repaired_surface(input, options, result);
+  diefill::log::debug("repair: soup, orientation, stitching and holes done at {:.2f} s", clock.seconds());
+  if (r.closed && r.self_intersecting) weld_folds_of_a_seam(r, options, result);
+  if (r.closed && r.self_intersecting) {
+    unite_intersecting_shells(r, options, result);
+    diefill::log::debug("repair: union tried at {:.2f} s", clock.seconds());
+  }
+  if (r.closed && !r.self_intersecting)
+    orient_closed_shells(r, source, result);
+  else
+    solid_of_a_broken_surface(r, input, options, source, result);
+  diefill::log::debug("repair: closed-surface checks done at {:.2f} s", clock.seconds());
+
+  measure_what_repair_moved(r, input, options, source, result);
+  result.after = same_mesh(r.mesh, input) ? result.before : inspect(r.mesh);
+  result.mesh = std::move(r.mesh);
   result.repaired = !result.actions.empty();
   return result;
 }
