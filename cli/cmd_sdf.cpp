@@ -27,7 +27,12 @@ int run_sdf(const SdfCommand& c) {
   const mesh::PreparedDie die = mesh::prepare_die(file, options, std::nullopt);
   fmt::print("mesh {} ({} units{}: {})\n", die.source, mesh::unit_name(options.unit),
              file.unit_guessed ? ", guessed from its size; --units chooses" : "", die.sha256);
-  if (die.part > 0) fmt::print("part {}: the body of that rank in the file by enclosed volume, largest first (--part)\n", die.part);
+  if (file.part > 0)
+    fmt::print("part {} of the file's {} bodies (pieces that share no vertex), numbered by enclosed volume, largest first (--part)\n",
+               file.part, file.bodies);
+  else if (file.bodies > 1)
+    fmt::print("the file holds {} bodies (pieces that share no vertex), taken as one part; --part N takes the N-th largest alone\n",
+               file.bodies);
   if (die.up != mesh::Up{})
     fmt::print("orientation: the opening faces {} in the file ({}); turned so that it faces +z\n", mesh::up_name(die.up),
                !die.up_found ? "--up"

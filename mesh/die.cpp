@@ -125,6 +125,31 @@ void cut_at_parting_plane(PreparedDie& die, const std::string& source) {
   die.after = inspect(die.cavity);
 }
 
+// The `part`-th largest of an assembly's bodies by enclosed volume (1: the largest; ties in the
+// file's order). A die forms one part; an assembly's parts stand apart by clearances no die wall
+// is as thin as (README, "Assemblies").
+TriMesh body_of_assembly(std::vector<TriMesh> bodies, int part, const std::string& source) {
+  std::vector<double> volume(bodies.size());
+  std::transform(bodies.begin(), bodies.end(), volume.begin(), [](const TriMesh& b) { return std::abs(signed_volume(b)); });
+  std::vector<std::size_t> largest_first(bodies.size());
+  std::iota(largest_first.begin(), largest_first.end(), 0);
+  std::stable_sort(largest_first.begin(), largest_first.end(), [&](std::size_t a, std::size_t b) { return volume[a] > volume[b]; });
+  if (part >= 1 && std::size_t(part) <= bodies.size()) return std::move(bodies[largest_first[std::size_t(part) - 1]]);
+  std::string largest;
+  for (std::size_t k = 0; k < std::min<std::size_t>(5, bodies.size()); ++k) {
+    const Box box = bounding_box(bodies[largest_first[k]]);
+    const Vec3 size = 1e3 * box.size(), at = 1e3 * box.lo;
+    largest += fmt::format("{}{}: {:.4g} mm³, {:.3g} x {:.3g} x {:.3g} mm from ({:.4g}, {:.4g}, {:.4g})", k ? "; " : "", k + 1,
+                           volume[largest_first[k]] * 1e9, size.x(), size.y(), size.z(), at.x(), at.y(), at.z());
+  }
+  throw InputError(source, "part",
+                   fmt::format("part {} was asked for, and the file holds {} separate bodies (the largest: {})", part,
+                               bodies.size(), largest),
+                   fmt::format("Choose a part from 1 to {} (die.part, diefill sdf --part), numbered by volume, largest "
+                               "first, or 0 for the whole file",
+                               bodies.size()));
+}
+
 }  // namespace
 
 WallRole parse_role(std::string_view text, std::string_view field) {
@@ -174,29 +199,6 @@ std::string die_cache_key(const DieFile& file, std::optional<double> parting_z, 
   return diefill::sha256_hex(text);
 }
 
-TriMesh body_of_assembly(const TriMesh& mesh, int part, const std::string& source) {
-  std::vector<TriMesh> bodies = separate_bodies(mesh);
-  std::vector<double> volume(bodies.size());
-  std::transform(bodies.begin(), bodies.end(), volume.begin(), [](const TriMesh& b) { return std::abs(signed_volume(b)); });
-  std::vector<std::size_t> largest_first(bodies.size());
-  std::iota(largest_first.begin(), largest_first.end(), 0);
-  std::stable_sort(largest_first.begin(), largest_first.end(), [&](std::size_t a, std::size_t b) { return volume[a] > volume[b]; });
-  if (part >= 1 && std::size_t(part) <= bodies.size()) return std::move(bodies[largest_first[std::size_t(part) - 1]]);
-  std::string largest;
-  for (std::size_t k = 0; k < std::min<std::size_t>(5, bodies.size()); ++k) {
-    const Box box = bounding_box(bodies[largest_first[k]]);
-    const Vec3 size = 1e3 * box.size(), at = 1e3 * box.lo;
-    largest += fmt::format("{}{}: {:.4g} mm³, {:.3g} x {:.3g} x {:.3g} mm from ({:.4g}, {:.4g}, {:.4g})", k ? "; " : "", k + 1,
-                           volume[largest_first[k]] * 1e9, size.x(), size.y(), size.z(), at.x(), at.y(), at.z());
-  }
-  throw InputError(source, "part",
-                   fmt::format("part {} was asked for, and the file holds {} separate bodies (the largest: {})", part,
-                               bodies.size(), largest),
-                   fmt::format("Choose a part from 1 to {} (die.part, diefill sdf --part), numbered by volume, largest "
-                               "first, or 0 for the whole file",
-                               bodies.size()));
-}
-
 DieFile read_die_file(const fs::path& path, std::optional<LengthUnit> unit, std::optional<Up> up, Parting parting, int part) {
   DieFile file;
   file.source = path.string();
@@ -206,8 +208,10 @@ DieFile read_die_file(const fs::path& path, std::optional<LengthUnit> unit, std:
   file.unit = imported.unit;
   file.unit_guessed = imported.unit_guessed;
   // The unit is the file's, guessed from all of it; the opening is the part's own.
+  std::vector<TriMesh> bodies = separate_bodies(imported.mesh);
+  file.bodies = bodies.size();
   file.part = part;
-  file.mesh = part == 0 ? std::move(imported.mesh) : body_of_assembly(imported.mesh, part, file.source);
+  file.mesh = part == 0 ? std::move(imported.mesh) : body_of_assembly(std::move(bodies), part, file.source);
   file.sha256 = diefill::sha256_file(path);
   file.up_found = !up;
   const bool opens = up ? opening_area(file.mesh, *up) > 0 : has_flat_extreme(file.mesh);

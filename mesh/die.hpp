@@ -79,9 +79,11 @@ struct DieFile {
   // `parting` asks for it; the part above it is left to the upper punch. Unset: the table lies at
   // the part's flat top face.
   std::optional<double> parting_z;
-  // The body of an assembly's file the die is for (`die.part`, body_of_assembly): 1 the largest
-  // by volume; 0 the whole file.
+  // The body of an assembly's file the die is for (`die.part`): 1 the largest by enclosed volume,
+  // ties in the file's order; 0 the whole file. Bodies are the pieces that share no vertex
+  // (separate_bodies); `bodies`: how many the file holds.
   int part = 0;
+  std::size_t bodies = 0;
   TriMesh mesh;        // [m], turned: the whole file, or the part chosen
 };
 // Reads the file in `unit` (unset: guessed from its size, with a warning), keeps its body `part`
@@ -91,13 +93,6 @@ struct DieFile {
 // when `parting` is Parting::opening.
 DieFile read_die_file(const std::filesystem::path& path, std::optional<LengthUnit> unit, std::optional<Up> up = Up{},
                       Parting parting = Parting::automatic, int part = 0);
-
-// The `part`-th largest body of an assembly's file by enclosed volume (1: the largest; ties in the
-// file's order), its bodies being the pieces that share no vertex (separate_bodies). A die forms
-// one part; an assembly's parts stand apart by clearances no die wall is as thin as (README,
-// "Assemblies"). Throws InputError naming `source`, the bodies and the largest ones when the file
-// holds fewer than `part`.
-TriMesh body_of_assembly(const TriMesh& mesh, int part, const std::string& source);
 
 // The `up` to read a die's file with: the options' own, or for a cavity unset (its opening is
 // found); a tool or a container is not turned.

@@ -39,6 +39,10 @@ DieSource read_die(const PipelineScene& scene, const std::filesystem::path& die_
     diefill::log::warn("{}: its opening (a flat face at its extreme) faces {} in the file; turned so that it faces up. "
                        "Set die.up to choose another way",
                        die.file.name, mesh::up_name(die.file.up));
+  if (die.file.part == 0 && die.file.bodies > 1)
+    diefill::log::info("{}: the file holds {} separate bodies (pieces that share no vertex), filled as one part; if they are "
+                       "an assembly's parts, die.part = N takes the N-th largest alone (README, \"Assemblies\")",
+                       die.file.name, die.file.bodies);
   die.box = mesh::bounding_box(die.file.mesh);
   if (die.file.parting_z) {
     // The height of the cut is said once, by the repair action that makes it (mesh/die.cpp), on

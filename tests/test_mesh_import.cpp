@@ -240,6 +240,7 @@ TEST(Assembly, APartIsOneBodyOfTheFileNumberedByVolume) {
   EXPECT_NEAR(mesh::bounding_box(second.mesh).lo.x(), 0, 1e-9);
   EXPECT_NEAR(mesh::bounding_box(third.mesh).lo.x(), 40e-3, 1e-9);
   EXPECT_EQ(third.part, 3);
+  EXPECT_EQ(whole.bodies, 3u);
   try {
     part(4);
     ADD_FAILURE() << "the file holds three bodies";
