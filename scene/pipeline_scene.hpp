@@ -22,7 +22,7 @@ struct PipelineScene {
   std::string die_role = "cavity";
   std::string die_up = "auto";
   std::string die_parting = "auto";
-  int die_part = 0;  // the body of an assembly's file (mesh::body_of_assembly); 0: the whole file
+  int die_part = 0;  // the body of an assembly's file (mesh::DieFile::part); 0: the whole file
   double die_voxel_fraction = 0.25;  // SDF voxel edge [largest grain radii] (mesh::default_voxel_fraction)
   // [shoe] (metres)
   double shoe_length = 32e-3, shoe_width = 50e-3, shoe_height = 37e-3, shoe_wall = 3e-3;
