@@ -110,10 +110,16 @@ struct CheckpointGrain {
   GrainRecord grain;
   Vec3 f, torque;
 };
+// A grain's wall slots, each laid out as a WallSlot with its padding named (as GrainRecord's).
 struct SlotRecord {
   std::int64_t id;
-  WallSlot slot[wall_slots_per_particle];
+  struct {
+    std::int32_t wall, unused;
+    Vec3 normal;
+    ContactHistory history;
+  } slot[wall_slots_per_particle];
 };
+static_assert(sizeof(SlotRecord) == sizeof(std::int64_t) + wall_slots_per_particle * sizeof(WallSlot));
 struct SplitImage {
   double time = 0, wall_work = 0, energy_reference = 0, energy_scale = 0, loop_max_overlap_rel = 0, loop_max_energy_gain = 0;
   std::int64_t step = 0, lost = 0;
@@ -211,7 +217,7 @@ State share_of_image(const SplitImage& image, std::shared_ptr<Exchange> exchange
   for (const SlotRecord& r : image.slots)
     if (const auto at = index.find(r.id); at != index.end()) {
       s.neighbours.near_wall.push_back(std::int32_t(at->second));
-      s.wall_slots.insert(s.wall_slots.end(), r.slot, r.slot + wall_slots_per_particle);
+      for (const auto& slot : r.slot) s.wall_slots.push_back({slot.wall, slot.normal, slot.history});
     }
   for (const CarriedPair& c : image.pairs)
     if (index.count(c.id)) s.carried_pairs.push_back(c);

@@ -24,6 +24,7 @@ struct BodyRecord {
   double mass, volume;
   std::int32_t members;
   std::uint8_t active;
+  std::uint8_t unused[3];  // the padding, named, as GrainRecord's
 };
 // A member of a body, named by its global id, with its offset in the body's principal frame.
 struct MemberRecord {

@@ -31,6 +31,7 @@ struct GrainRecord {
   double radius, mass, inertia;
   std::int32_t material;
   std::uint8_t active;
+  std::uint8_t unused[3];  // the padding, named: copies (a sort's too) keep it zero, and a file the same
 };
 
 // Byte buffers of plain records. The records hold numbers and Eigen's fixed-size vectors, which

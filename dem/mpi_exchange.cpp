@@ -3,6 +3,7 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <limits>
 
 #include "dem/distributed.hpp"
 #include "dem/model.hpp"
@@ -25,7 +26,7 @@ struct GhostMotion {
 };
 class MpiExchange final : public Exchange {
  public:
-  MpiExchange() {
+  explicit MpiExchange(std::size_t largest_message) : largest_message_(largest_message) {
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &ranks_);
   }
@@ -63,6 +64,16 @@ class MpiExchange final : public Exchange {
   }
 
  private:
+  struct Outgoing {
+    int to;
+    const std::vector<char>* bytes;
+  };
+  // Sends each buffer of `out` to its rank and receives one from every rank of `from`: returns
+  // those, concatenated in `from`'s order. Every transfer between ranks goes through here. MPI
+  // counts bytes in int, which a gathered state or a migration can outgrow (a gather of 20 M
+  // grains is over 2 GiB), and Open MPI 4.1 has no MPI_Count variants: the sizes travel as 64-bit
+  // counts, the bytes in messages of at most largest_message_.
+  std::vector<char> transfer(const std::vector<Outgoing>& out, const std::vector<int>& from) const;
   // Each rank's buffer to it; returns what every rank sent here, in rank order.
   std::vector<char> all_to_all(const std::vector<std::vector<char>>& out) const;
   // The same when only the neighbouring subdomains' buffers can hold anything: messages to and
@@ -71,6 +82,7 @@ class MpiExchange final : public Exchange {
   void migrate(State& s);
   void send_ghosts(const Model& model, State& s);
 
+  std::size_t largest_message_;
   int rank_ = 0, ranks_ = 1;
   RcbPartition cuts_;
   std::vector<std::vector<std::int32_t>> send_;  // [ranks] owned grains ghosted there, in send order
@@ -79,52 +91,54 @@ class MpiExchange final : public Exchange {
   std::vector<int> neighbours_;
 };
 
-std::vector<char> MpiExchange::all_to_all(const std::vector<std::vector<char>>& out) const {
-  std::vector<int> send_counts(static_cast<std::size_t>(ranks_)), receive_counts(static_cast<std::size_t>(ranks_));
-  for (std::size_t r = 0; r < out.size(); ++r) send_counts[r] = int(out[r].size());
-  MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
-  std::vector<int> send_at(static_cast<std::size_t>(ranks_), 0), receive_at(static_cast<std::size_t>(ranks_), 0);
-  for (std::size_t r = 1; r < std::size_t(ranks_); ++r) {
-    send_at[r] = send_at[r - 1] + send_counts[r - 1];
-    receive_at[r] = receive_at[r - 1] + receive_counts[r - 1];
+std::vector<char> MpiExchange::transfer(const std::vector<Outgoing>& out, const std::vector<int>& from) const {
+  std::vector<std::uint64_t> sizes(out.size()), receive_sizes(from.size());
+  std::vector<MPI_Request> requests;
+  const auto wait = [&] {
+    MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
+    requests.clear();
+  };
+  for (std::size_t k = 0; k < from.size(); ++k)
+    MPI_Irecv(&receive_sizes[k], 1, MPI_UINT64_T, from[k], 0, MPI_COMM_WORLD, &requests.emplace_back());
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    sizes[k] = out[k].bytes->size();
+    MPI_Isend(&sizes[k], 1, MPI_UINT64_T, out[k].to, 0, MPI_COMM_WORLD, &requests.emplace_back());
   }
-  std::vector<char> sending, received(std::size_t(receive_at.back() + receive_counts.back()));
-  for (const auto& b : out) sending.insert(sending.end(), b.begin(), b.end());
-  MPI_Alltoallv(sending.data(), send_counts.data(), send_at.data(), MPI_BYTE, received.data(), receive_counts.data(),
-                receive_at.data(), MPI_BYTE, MPI_COMM_WORLD);
+  wait();
+  std::vector<std::size_t> at(from.size() + 1, 0);
+  for (std::size_t k = 0; k < from.size(); ++k) at[k + 1] = at[k] + std::size_t(receive_sizes[k]);
+  std::vector<char> received(at.back());
+  // Both sides cut a buffer alike, from its size; MPI keeps the order of the messages between two
+  // ranks with one tag, so that the k-th piece sent meets the k-th receive.
+  const auto piece = [&](std::size_t size, std::size_t offset) { return int(std::min(size - offset, largest_message_)); };
+  for (std::size_t k = 0; k < from.size(); ++k)
+    for (std::size_t o = 0; o < at[k + 1] - at[k]; o += largest_message_)
+      MPI_Irecv(received.data() + at[k] + o, piece(at[k + 1] - at[k], o), MPI_BYTE, from[k], 1, MPI_COMM_WORLD,
+                &requests.emplace_back());
+  for (const Outgoing& o : out)
+    for (std::size_t b = 0; b < o.bytes->size(); b += largest_message_)
+      MPI_Isend(o.bytes->data() + b, piece(o.bytes->size(), b), MPI_BYTE, o.to, 1, MPI_COMM_WORLD, &requests.emplace_back());
+  wait();
   return received;
 }
 
-std::vector<char> MpiExchange::gather(const std::vector<char>& local) {
-  const int bytes = int(local.size());
-  std::vector<int> counts(static_cast<std::size_t>(ranks_)), at(static_cast<std::size_t>(ranks_), 0);
-  MPI_Gather(&bytes, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
-  for (std::size_t r = 1; r < std::size_t(ranks_); ++r) at[r] = at[r - 1] + counts[r - 1];
-  std::vector<char> all(rank_ == 0 ? std::size_t(at.back() + counts.back()) : 0);
-  MPI_Gatherv(local.data(), bytes, MPI_BYTE, all.data(), counts.data(), at.data(), MPI_BYTE, 0, MPI_COMM_WORLD);
-  return all;
+std::vector<char> MpiExchange::all_to_all(const std::vector<std::vector<char>>& out) const {
+  std::vector<Outgoing> sending;
+  std::vector<int> every(static_cast<std::size_t>(ranks_));
+  for (int r = 0; r < ranks_; ++r) sending.push_back({r, &out[std::size_t(r)]}), every[std::size_t(r)] = r;
+  return transfer(sending, every);
 }
 
 std::vector<char> MpiExchange::with_neighbours(const std::vector<std::vector<char>>& out) const {
-  const std::size_t n = neighbours_.size();
-  std::vector<int> send_counts(n), receive_counts(n), receive_at(n + 1, 0);
-  std::vector<MPI_Request> requests(2 * n);
-  const auto wait = [&] { MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE); };
-  for (std::size_t k = 0; k < n; ++k) {
-    send_counts[k] = int(out[std::size_t(neighbours_[k])].size());
-    MPI_Irecv(&receive_counts[k], 1, MPI_INT, neighbours_[k], 0, MPI_COMM_WORLD, &requests[k]);
-    MPI_Isend(&send_counts[k], 1, MPI_INT, neighbours_[k], 0, MPI_COMM_WORLD, &requests[n + k]);
-  }
-  wait();
-  for (std::size_t k = 0; k < n; ++k) receive_at[k + 1] = receive_at[k] + receive_counts[k];
-  std::vector<char> received(static_cast<std::size_t>(receive_at[n]));
-  for (std::size_t k = 0; k < n; ++k) {
-    MPI_Irecv(received.data() + receive_at[k], receive_counts[k], MPI_BYTE, neighbours_[k], 1, MPI_COMM_WORLD, &requests[k]);
-    MPI_Isend(out[std::size_t(neighbours_[k])].data(), send_counts[k], MPI_BYTE, neighbours_[k], 1, MPI_COMM_WORLD,
-              &requests[n + k]);
-  }
-  wait();
-  return received;
+  std::vector<Outgoing> sending;
+  for (int r : neighbours_) sending.push_back({r, &out[std::size_t(r)]});
+  return transfer(sending, neighbours_);
+}
+
+std::vector<char> MpiExchange::gather(const std::vector<char>& local) {
+  std::vector<int> every;
+  for (int r = 0; rank_ == 0 && r < ranks_; ++r) every.push_back(r);
+  return transfer({{0, &local}}, every);
 }
 
 void MpiExchange::redistribute(const Model& model, State& s) {
@@ -297,6 +311,8 @@ void MpiExchange::update_ghosts(State& s) {
 
 }  // namespace
 
-std::shared_ptr<Exchange> make_mpi_exchange() { return std::make_shared<MpiExchange>(); }
+std::shared_ptr<Exchange> make_mpi_exchange(std::size_t largest_message) {
+  return std::make_shared<MpiExchange>(std::clamp<std::size_t>(largest_message, 1, std::numeric_limits<int>::max()));
+}
 
 }  // namespace dem
