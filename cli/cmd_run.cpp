@@ -5,11 +5,13 @@
 #include <algorithm>
 #include <cctype>
 #include <set>
+#include <string_view>
 
 #include "cli/commands.hpp"
 #include "cli/mpi_session.hpp"
 #include "pipeline/compare.hpp"
 #include "pipeline/die_fill.hpp"
+#include "pipeline/preflight.hpp"
 #include "pipeline/sweep.hpp"
 #include "pipeline/run_loop.hpp"
 #include "core/atomic_file.hpp"
@@ -36,6 +38,7 @@ void apply_command_line(PipelineScene& scene, const RunCommand& c) {
   if (c.seed) scene.seed = *c.seed;
   if (c.up) scene.die_up = *c.up;
   if (c.units) scene.die_units = *c.units;
+  scene.force = c.force;
 }
 
 // The mesh formats a CAD tool writes and assimp reads; anything else in the folder (a README, a
@@ -58,6 +61,30 @@ std::vector<fs::path> meshes_in(const fs::path& folder) {
   return files;
 }
 
+// A word as the shell reads it back: quoted unless it is plain.
+std::string shell_word(const std::string& word) {
+  const bool plain = !word.empty() && std::all_of(word.begin(), word.end(), [](unsigned char ch) {
+    return std::isalnum(ch) || std::string_view("/._-=+,:@%").find(char(ch)) != std::string_view::npos;
+  });
+  if (plain) return word;
+  std::string quoted = "'";
+  for (char ch : word) quoted += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+  return quoted + "'";
+}
+
+// The command that resumes an interrupted run: its own arguments, the folder it wrote into (so
+// that it works from any working folder) and --resume.
+std::string resume_command(const RunCommand& c, const fs::path& out) {
+  std::string line = "diefill run " + shell_word(c.target.string()) + " --out " + shell_word(out.string());
+  for (const std::string& o : c.overrides) line += " --set " + shell_word(o);
+  if (c.threads) line += fmt::format(" --threads {}", *c.threads);
+  if (c.seed) line += fmt::format(" --seed {}", *c.seed);
+  if (c.up) line += " --up " + shell_word(*c.up);
+  if (c.units) line += " --units " + shell_word(*c.units);
+  if (c.force) line += " --force";
+  return line + " --resume";
+}
+
 }  // namespace
 
 int run_scene(const SceneCommand& c) {
@@ -65,7 +92,22 @@ int run_scene(const SceneCommand& c) {
     fmt::print("{}", scene_keys_markdown());
     return 0;
   }
-  fmt::print("{}", describe(scene_for(c.target, c.overrides)));
+  PipelineScene scene = scene_for(c.target, c.overrides);
+  scene.force = c.force;
+  // Every check a run makes before its first step but those that need the die's distance field
+  // (its repair, whether grains enter it), which the run builds and caches.
+  preflight_laws(scene);
+  std::string size;
+  if (!scene.die.empty()) {
+    const DieSource die = read_die(scene, scene.die);
+    ShoePlan shoe = plan_shoe(scene, die);
+    const GrainSizing grains = size_grains(scene, shoe, die.file.name);
+    set_clearance(scene, grains, die.table_z, shoe);
+    const RunSize run = preflight(scene, die, shoe, grains);
+    refuse_oversized(scene, run, die.file.source);
+    size = describe_size(run, die.file.name);
+  }
+  fmt::print("{}{}", describe(scene), size);
   return 0;
 }
 
@@ -100,7 +142,12 @@ int run_pipeline(const RunCommand& c) {
       throw diefill::InputError(c.target.string(), "die.file", "names no die", "Give [die] file = \"...\" or run a mesh");
     const DieRun run = run_die_fill(scene, scene.die, c.resume, ranks);
     if (run.interrupted) {
-      if (root) fmt::print(stderr, "interrupted; resume with `diefill run {} --resume`\n", c.target.string());
+      if (!root) return diefill::exit_interrupted;
+      if (fs::exists(run.dir / "checkpoint.bin"))
+        fmt::print(stderr, "interrupted; resume with `{}`{}\n", resume_command(c, scene.out),
+                   ranks ? " under the same mpirun" : "");
+      else
+        fmt::print(stderr, "interrupted before the shoe moved: no checkpoint to resume from; rerun the command to start again\n");
       return diefill::exit_interrupted;
     }
     if (root) fmt::print("{}: report {}\n", run.die, (run.dir / "report.json").string());

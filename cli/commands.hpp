@@ -39,6 +39,7 @@ struct RunCommand {
   std::optional<std::string> up;     // die.up
   std::optional<std::string> units;  // die.units
   bool resume = false;
+  bool force = false;  // a size over the limit runs (pipeline/preflight.hpp)
   std::optional<std::string> sweep;  // KEY=V1,V2,...: one run per value (pipeline/sweep.hpp)
 };
 int run_pipeline(const RunCommand& command);
@@ -53,6 +54,7 @@ struct SceneCommand {
   std::filesystem::path target;
   std::vector<std::string> overrides;
   bool keys = false;  // the reference of every key (Markdown) instead of the resolved scene
+  bool force = false;  // a size over the limit is printed, not refused
 };
 int run_scene(const SceneCommand& command);
 

@@ -49,6 +49,7 @@ void add_run(CLI::App& root, app::RunCommand& c, std::function<int()>& action) {
   cmd->add_option("--up", c.up, "The way the die's opening faces in its file: +x, -x, +y, -y, +z, -z or auto (die.up)");
   cmd->add_option("--units", c.units, "Length unit of the die's file: mm, m, in, or auto (die.units)");
   cmd->add_flag("--resume", c.resume, "Continue an interrupted run from its checkpoint");
+  cmd->add_flag("--force", c.force, "Run a scene whose size is over the limit (10³ times the default ring run's work)");
   cmd->add_option("--sweep", c.sweep,
                   "Run once per value of a scene key, each into OUT/KEY=VALUE/, with a summary table and chart: "
                   "--sweep motion.speed=0.05,0.1,0.2");
@@ -60,6 +61,7 @@ void add_scene(CLI::App& root, app::SceneCommand& c, std::function<int()>& actio
   cmd->add_option("TARGET", c.target, "Die mesh or scene (.toml)");
   cmd->add_option("--set", c.overrides, "Override a scene key");
   cmd->add_flag("--keys", c.keys, "Print every key with its type, unit, default, range and meaning (Markdown)");
+  cmd->add_flag("--force", c.force, "Accept a size over the limit, as `run --force` would");
   cmd->callback([&] { action = [&] { return app::run_scene(c); }; });
 }
 

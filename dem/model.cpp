@@ -164,18 +164,11 @@ Model compile_model(const ModelSpec& spec, const State& state, const std::string
     diefill::log::warn("{}: at {:.3g} m/s a grain moves {:.3g} m per step, more than half the neighbour skin "
                        "{:.3g} m: contacts could be missed. Lower the time step or widen the skin",
                        source, spec.max_impact_speed, spec.max_impact_speed * m.dt, m.skin);
-  // A wall's motion is known exactly, so a wall that could pass grains unseen is refused: the
-  // grains near it are listed at a rebuild, and a rebuild comes once it has moved half the skin.
-  // A rotating wall's points move by up to |ω| times their distance from the pivot on top.
+  // A wall's motion is known exactly, so a wall that could pass grains unseen is refused. A
+  // rotating wall's points move by up to |ω| times their distance from the pivot on top.
   for (std::size_t k = 0; k < spec.meshes.size(); ++k) {
     const MeshWall& w = spec.meshes[k];
-    const double top_speed = w.motion.top_speed() + w.motion.angular_velocity.norm() * m.mesh_reach[k];
-    if (const double per_step = top_speed * m.dt; per_step > 0.5 * m.skin)
-      throw InputError(source, "walls." + w.name + ".motion",
-                       fmt::format("the wall moves {:.3g} m per step at its top speed {:.3g} m/s, more than half the neighbour "
-                                   "skin {:.3g} m: it could pass through grains it has not listed",
-                                   per_step, top_speed, m.skin),
-                       "Lower the wall's speed or the time step, or widen simulation.skin");
+    check_wall_travel(w.name, w.motion.top_speed() + w.motion.angular_velocity.norm() * m.mesh_reach[k], m.dt, m.skin, source);
   }
   m.cell_size = 2 * m.max_radius + m.skin;
 
@@ -199,6 +192,15 @@ Model compile_model(const ModelSpec& spec, const State& state, const std::string
   }
   m.hash = diefill::sha256_hex(text);
   return m;
+}
+
+void check_wall_travel(const std::string& name, double top_speed, double dt, double skin, const std::string& source) {
+  if (const double per_step = top_speed * dt; per_step > 0.5 * skin)
+    throw InputError(source, "walls." + name + ".motion",
+                     fmt::format("the wall moves {:.3g} m per step at its top speed {:.3g} m/s, more than half the neighbour "
+                                 "skin {:.3g} m: it could pass through grains it has not listed",
+                                 per_step, top_speed, skin),
+                     "Lower the wall's speed or the time step, or widen simulation.skin");
 }
 
 }  // namespace dem

@@ -128,4 +128,10 @@ struct State;
 // pairs, calibrates damping, chooses the time step and skin for the particles in `state`.
 Model compile_model(const ModelSpec& spec, const State& state, const std::string& source);
 
+// InputError naming walls.<name>.motion when a wall at `top_speed` would move more than half the
+// skin in a step: the grains near it are listed at a rebuild, and a rebuild comes once it has
+// moved half the skin, so it could pass through grains it has not listed. compile_model checks
+// every wall so; the pipeline asks it before a wall exists (pipeline/preflight.hpp).
+void check_wall_travel(const std::string& name, double top_speed, double dt, double skin, const std::string& source);
+
 }  // namespace dem

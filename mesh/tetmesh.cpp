@@ -159,9 +159,9 @@ TetMesh tetrahedralise_body(const TriMesh& body, const TetMeshOptions& o) {
       ++out.dropped_boundary_slivers;
       continue;
     }
-    Tet t{node(c->vertex(0)), node(c->vertex(1)), node(c->vertex(2)), node(c->vertex(3))};
-    if (tet_volume(out.nodes[t[0]], out.nodes[t[1]], out.nodes[t[2]], out.nodes[t[3]]) < 0) std::swap(t[2], t[3]);
-    out.tets.push_back(t);
+    // CGAL's cells are positively oriented, which is C3D4's order: kept as they come, so that a
+    // cell the coordinates' rounding turned inside out is counted (tet_quality), not hidden.
+    out.tets.push_back({node(c->vertex(0)), node(c->vertex(1)), node(c->vertex(2)), node(c->vertex(3))});
   }
   for (auto e = c3t3.edges_in_complex_begin(); e != c3t3.edges_in_complex_end(); ++e)
     out.feature_edges.push_back({node(e->first->vertex(e->second)), node(e->first->vertex(e->third))});

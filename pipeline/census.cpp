@@ -54,18 +54,25 @@ double member_weight(const dem::State& s, std::size_t body) {
   return b.volume[body] / members;
 }
 
-Census count_grains(const dem::State& state, double table_z, const ShoePlan& shoe) {
+Census count_grains(const dem::State& state, std::size_t inserted, double table_z, const ShoePlan& shoe,
+                    const dem::Box3& domain) {
   Census c;
+  c.inserted = inserted;
   const Vec3 shoe_centre = shoe.motion.position(state.time);
   std::vector<post::Grain> all;
   for (const GrainRef& g : grains_of(state)) {
     ++c.grains;
     add_volume(state, g, all);
-    // A grain that left the domain above the table spilled over its edge beside the shoe:
-    // counted, and harmless to the fill. One that left below it went through the die: a leak.
+    // A grain is frozen at the first neighbour build after it left the domain (docs/PHYSICS.md),
+    // within half a skin of the face it crossed: below the table it went through the die (a
+    // leak); beyond the sides, over the table's edge beside the shoe (spilled, harmless to the
+    // fill); through the top it was thrown out, which only a fault does (lost).
     if (!g.active) {
-      ++c.lost;
+      const bool beside = (g.centre.head<2>().array() < domain.lo.head<2>().array()).any() ||
+                          (g.centre.head<2>().array() > domain.hi.head<2>().array()).any();
       if (g.centre.z() < table_z) c.leak = g.centre, ++c.leaked;
+      else if (beside) ++c.spilled;
+      else ++c.lost;
     } else if (g.centre.z() < table_z) {
       ++c.in_cavity;
       add_volume(state, g, c.cavity);
@@ -76,6 +83,8 @@ Census count_grains(const dem::State& state, double table_z, const ShoePlan& sho
       ++c.elsewhere;
     }
   }
+  // A grain the final state no longer holds is lost too (a fault of the exchange or the gather).
+  if (c.inserted > c.grains) c.lost += c.inserted - c.grains;
   // Summed from the same weighted members the density binning gets, so that the report shows the
   // volume the field holds.
   for (const post::Grain& g : all) c.grain_volume_m3 += g.weight * 4.0 / 3.0 * std::numbers::pi * std::pow(g.radius, 3);
@@ -84,15 +93,19 @@ Census count_grains(const dem::State& state, double table_z, const ShoePlan& sho
 
 void check_losses(const Census& c, const std::string& die_source, const std::string& die_name) {
   if (c.leaked > 0)
-    throw diefill::InputError(die_source, "particles.lost",
+    throw diefill::InputError(die_source, "particles.leaked",
                               fmt::format("{} grains left the simulated domain below the die table, through the die (one at "
                                           "({:.3g}, {:.3g}, {:.3g}) mm)",
                                           c.leaked, c.leak.x() * 1e3, c.leak.y() * 1e3, c.leak.z() * 1e3),
                               "Check the die mesh for holes or walls thinner than its voxels");
-  if (c.lost > 0)
-    diefill::log::warn("{}: {} grains spilled over the die table's edge beside the shoe; counted in report.json "
-                       "(particles.lost), not in the fill",
-                       die_name, c.lost);
+  if (c.grains != c.inserted || c.lost > 0)
+    diefill::log::warn("{}: {} grains lost to a fault (thrown out through the simulated domain's top, or missing: {} "
+                       "inserted, {} in the final state); report.json's stability.checks_passed is false",
+                       die_name, c.lost, c.inserted, c.grains);
+  if (c.spilled > 0)
+    diefill::log::info("{}: {} grains spilled over the die table's edge beside the shoe; counted in report.json "
+                       "(particles.spilled), not in the fill",
+                       die_name, c.spilled);
   // A shoe that ends (nearly) empty may have run out before the cavity was full: a die larger
   // than the shoe's powder (the shared 304 mm flange disc under a 3000-grain shoe) is no fill.
   if (c.in_shoe * 20 < c.grains)

@@ -8,6 +8,7 @@
 #include "pipeline/census.hpp"
 #include "pipeline/outputs.hpp"
 #include "pipeline/plan.hpp"
+#include "pipeline/preflight.hpp"
 #include "pipeline/shoe_fill.hpp"
 #include "pipeline/shoe_pass.hpp"
 #include "pipeline/walls.hpp"
@@ -55,6 +56,7 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
   ShoePlan shoe = plan_shoe(s, source);
   const GrainSizing grains = size_grains(s, shoe, source.file.name);
   set_clearance(s, grains, source.table_z, shoe);
+  refuse_oversized(s, preflight(s, source, shoe, grains), source.file.source);
   const FillWalls walls = walls_rank0_first(s, source, grains, shoe, ranks);
   DieRun run{walls.die.name, {}, s.out / walls.die.name, false};
   fs::create_directories(run.dir);
@@ -71,7 +73,7 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
   }
   if (ranks && ranks->rank() != 0) return run;  // rank 0 counts and writes
 
-  const Census census = count_grains(fill->state, source.table_z, shoe);
+  const Census census = count_grains(fill->state, settled->inserted, source.table_z, shoe, walls.spec.domain);
   check_losses(census, source.file.source, walls.die.name);
   const FillRecord record{s, walls, grains, shoe, *settled, *fill, census, source.table_z, clock.seconds(), ranks ? ranks->ranks() : 1};
   run.report = write_fill_outputs(record, run.dir);

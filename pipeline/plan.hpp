@@ -35,6 +35,11 @@ struct GrainSizing {
   std::size_t count = 0;     // grains that fill the shoe to shoe.fill_height
 };
 
+// Random insertion jams near a third of the volume (random sequential adsorption), so a bed of
+// poured density 0.6 needs about twice its height of space; a round fills what space the shoe
+// has above the powder already in it, and the powder settles before the next, up to this many.
+inline constexpr int max_insertion_rounds = 4;
+
 ShoePlan plan_shoe(const PipelineScene& scene, const DieSource& die);
 GrainSizing size_grains(const PipelineScene& scene, const ShoePlan& shoe, const std::string& die_name);
 // The shoe's start raised by the clearance under its walls, now that the grains are sized.

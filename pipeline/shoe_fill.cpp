@@ -25,10 +25,6 @@ using dem::Vec3;
 
 namespace {
 
-// Random insertion jams near a third of the volume (random sequential adsorption), so a bed of
-// poured density 0.6 needs about twice its height of space; a round fills what space the shoe
-// has above the powder already in it, and the powder settles before the next.
-constexpr int max_insertion_rounds = 4;
 constexpr double insertion_solid_fraction = 0.45;  // stop a round's insertion at this fill of its box
 
 struct Insertion {

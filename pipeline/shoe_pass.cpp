@@ -44,7 +44,9 @@ void write_series(const mesh::TriMesh& die_solid, const std::vector<double>& tim
 
 // What the outputs of an interrupted fill wrote before its checkpoint (beside it, as
 // checkpoint_outputs.json): the cadence's origin, the fill curve's samples and the snapshots'
-// times, so that the resumed run's fill curve and series are the uninterrupted run's.
+// times, so that the resumed run's fill curve and series are the uninterrupted run's; and the
+// seed, which the checkpoint's model hash does not hold, so that a resume under another seed
+// cannot report that seed for this run's grains.
 struct OutputsSoFar {
   double origin = 0;  // [s]
   std::vector<FillSample> curve;
@@ -54,16 +56,16 @@ struct OutputsSoFar {
 fs::path outputs_file(const fs::path& checkpoint) { return checkpoint.parent_path() / "checkpoint_outputs.json"; }
 
 void save_outputs(double origin, const std::vector<FillSample>& fill_curve, const std::vector<double>& snapshot_times,
-                  const fs::path& checkpoint) {
+                  std::uint64_t seed, const fs::path& checkpoint) {
   nlohmann::json curve = nlohmann::json::array();
   for (const FillSample& p : fill_curve) curve.push_back({p.time, p.shoe_x, p.grains, p.mass});
-  const nlohmann::json j = {{"origin_s", origin}, {"fill_curve", curve}, {"snapshot_times_s", snapshot_times}};
+  const nlohmann::json j = {{"origin_s", origin}, {"fill_curve", curve}, {"snapshot_times_s", snapshot_times}, {"seed", seed}};
   diefill::write_file_atomic(outputs_file(checkpoint), j.dump() + "\n");
 }
 
 // A checkpoint without that file beside it (deleted) resumes with the outputs from the
 // resumption on; said so.
-OutputsSoFar load_outputs(const fs::path& checkpoint, double origin) {
+OutputsSoFar load_outputs(const fs::path& checkpoint, double origin, std::uint64_t seed) {
   const fs::path file = outputs_file(checkpoint);
   if (!fs::exists(file)) {
     diefill::log::warn("{}: not found: the fill curve and the snapshot series start where the run resumes", file.string());
@@ -72,6 +74,10 @@ OutputsSoFar load_outputs(const fs::path& checkpoint, double origin) {
   try {
     std::ifstream in(file);
     const nlohmann::json j = nlohmann::json::parse(in);
+    if (j.contains("seed") && j.at("seed").get<std::uint64_t>() != seed)
+      throw diefill::InputError(checkpoint.string(), "simulation.seed",
+                                fmt::format("was written by a run of seed {}, not {}", j.at("seed").get<std::uint64_t>(), seed),
+                                fmt::format("Resume with --seed {}, or run without --resume to start afresh", j.at("seed").get<std::uint64_t>()));
     OutputsSoFar o{j.at("origin_s").get<double>(), {}, j.at("snapshot_times_s").get<std::vector<double>>()};
     for (const auto& p : j.at("fill_curve"))
       o.curve.push_back({p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<std::int64_t>(), p.at(3).get<double>()});
@@ -98,10 +104,11 @@ std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& wal
                                     : fs::exists(checkpoint);
   OutputsSoFar so_far{state.time, {}, {}};
   if (resume && found) {
-    so_far = load_outputs(checkpoint, state.time);
+    so_far = load_outputs(checkpoint, state.time, s.seed);
     state = dem::read_checkpoint(model, checkpoint, state.exchange);
     diefill::log::info("{}: resumed at t = {:.6g} s", walls.die.name, state.time);
   } else {
+    if (resume) diefill::log::warn("{}: --resume: no checkpoint in {}; the fill starts afresh", walls.die.name, dir.string());
     dem::initialize(model, state);
   }
   fill.curve = std::move(so_far.curve);
@@ -131,7 +138,7 @@ std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& wal
     return fmt::format("{} grains in the cavity", st.exchange ? std::size_t(st.exchange->sum(std::int64_t(n))) : n);
   };
   const auto keep_outputs = [&] {
-    if (dem::writes_outputs(state)) save_outputs(so_far.origin, fill.curve, snapshot_times, checkpoint);
+    if (dem::writes_outputs(state)) save_outputs(so_far.origin, fill.curve, snapshot_times, s.seed, checkpoint);
   };
   try {
     fill.loop = run_until(model, state, loop);

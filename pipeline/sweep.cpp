@@ -51,13 +51,13 @@ std::vector<DieRun> run_sweep(const std::function<PipelineScene(const std::vecto
     if (runs.back().interrupted) return runs;
   }
   if (ranks && ranks->rank() != 0) return runs;
-  std::string csv = fmt::format("{},fill_ratio,mass_kg,grains_in_cavity,lost,final_state_sha256,folder\n", sweep.key);
+  std::string csv = fmt::format("{},fill_ratio,mass_kg,grains_in_cavity,spilled,lost,final_state_sha256,folder\n", sweep.key);
   nlohmann::json cases = nlohmann::json::array();
   for (std::size_t k = 0; k < runs.size(); ++k) {
     const nlohmann::json& r = runs[k].report;
-    csv += fmt::format("{},{:.9g},{:.9g},{},{},{},{}\n", sweep.values[k], r["fill"]["fill_ratio"].get<double>(),
+    csv += fmt::format("{},{:.9g},{:.9g},{},{},{},{},{}\n", sweep.values[k], r["fill"]["fill_ratio"].get<double>(),
                        r["fill"]["mass_kg"].get<double>(), r["particles"]["in_cavity"].get<std::int64_t>(),
-                       r["particles"]["lost"].get<std::int64_t>(), r["final_state_sha256"].get<std::string>(), runs[k].dir.string());
+                       r["particles"]["spilled"].get<std::int64_t>(), r["particles"]["lost"].get<std::int64_t>(), r["final_state_sha256"].get<std::string>(), runs[k].dir.string());
     cases.push_back({{"value", sweep.values[k]},
                      {"fill_ratio", r["fill"]["fill_ratio"]},
                      {"mass_kg", r["fill"]["mass_kg"]},

@@ -9,6 +9,7 @@
 #include "core/log.hpp"
 #include "mesh/exact.hpp"
 #include "mesh/shapes.hpp"
+#include "pipeline/preflight.hpp"
 
 namespace app {
 
@@ -70,15 +71,7 @@ void check_grains_enter(const FillWalls& w, const DieSource& source, const Grain
 // The coarse-grained laws with the die and the shoe as walls, inside the table's extent.
 dem::ModelSpec fill_spec(const PipelineScene& s, const FillWalls& w, const DieSource& source, const GrainSizing& grains,
                          const ShoePlan& shoe, const mesh::TableExtent& table) {
-  dem::ModelSpec spec = coarse_grained_spec(s.spec, grains.alpha);
-  // The collision time must resolve the fastest impact: a grain falling the die's depth onto the
-  // floor, plus the shoe's speed.
-  const double impact = std::sqrt(2 * spec.gravity.norm() * source.box.size().z()) + s.speed;
-  if (impact > spec.max_impact_speed) {
-    diefill::log::info("{}: impacts reach {:.3g} m/s in this die; time step set for them (simulation.max_impact_speed was {:.3g})",
-                       w.die.name, impact, spec.max_impact_speed);
-    spec.max_impact_speed = impact;
-  }
+  dem::ModelSpec spec = fill_laws(s, grains, source.box.size().z());
   spec.domain = {Vec3(table.x_min, table.y_min, source.box.lo.z() - 1e-3),
                  Vec3(table.x_max, table.y_max, source.table_z + s.shoe_height + 5e-3)};
   spec.meshes.push_back(dem::fixed_mesh_wall(w.die_field, w.steel, "die"));

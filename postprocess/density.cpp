@@ -157,34 +157,59 @@ CavityVolumes cavity_fractions(const VoxelGrid& g, const std::function<double(co
   return out;
 }
 
+namespace {
+// The pool a voxel belongs to (union-find with path halving): a sliver joins its fullest
+// neighbour, which may be a sliver that joined another.
+std::size_t pool_of(std::vector<std::size_t>& parent, std::size_t n) {
+  while (parent[n] != n) n = parent[n] = parent[parent[n]];
+  return n;
+}
+}  // namespace
+
 CorrectedField correct_for_walls(const VoxelGrid& g, const std::vector<double>& solid,
                                  const std::vector<double>& cavity, double min_cavity) {
-  CorrectedField out;
-  out.solid_fraction.assign(g.size(), std::numeric_limits<double>::quiet_NaN());
-  out.merged.assign(g.size(), 0);
-  const double v = g.voxel_volume();
+  // Every voxel of a pool carries the pool's value, the host as well as its slivers: were the
+  // host to keep its own, Σ solid fraction × cavity volume would count the slivers' solid twice
+  // over and miss their cavity (0.38 % of the mass on the disc at 1 mm voxels, issue 44).
+  std::vector<std::size_t> parent(g.size());
+  for (std::size_t n = 0; n < g.size(); ++n) parent[n] = n;
+  const int steps[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
   for (int i = 0; i < g.nx; ++i)
     for (int j = 0; j < g.ny; ++j)
       for (int k = 0; k < g.nz; ++k) {
         const std::size_t n = g.index(i, j, k);
-        if (cavity[n] <= 0) continue;
-        if (cavity[n] >= min_cavity) {
-          out.solid_fraction[n] = solid[n] / (cavity[n] * v);
-          continue;
-        }
-        // Pool with the neighbour that has the most cavity.
+        if (cavity[n] <= 0 || cavity[n] >= min_cavity) continue;
         std::size_t best = n;
-        const int steps[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
         for (const auto& d : steps) {
           const int a = i + d[0], b = j + d[1], c = k + d[2];
           if (a < 0 || b < 0 || c < 0 || a >= g.nx || b >= g.ny || c >= g.nz) continue;
           const std::size_t m = g.index(a, b, c);
           if (cavity[m] > cavity[best]) best = m;
         }
-        out.solid_fraction[n] = (solid[n] + solid[best]) / ((cavity[n] + cavity[best]) * v);
-        out.merged[n] = 1;
-        ++out.merged_count;
+        parent[pool_of(parent, n)] = pool_of(parent, best);
       }
+  std::vector<double> pool_solid(g.size(), 0.0), pool_cavity(g.size(), 0.0);
+  std::vector<std::uint32_t> pool_size(g.size(), 0);
+  for (std::size_t n = 0; n < g.size(); ++n) {
+    if (cavity[n] <= 0) continue;
+    const std::size_t root = pool_of(parent, n);
+    pool_solid[root] += solid[n];
+    pool_cavity[root] += cavity[n];
+    ++pool_size[root];
+  }
+  CorrectedField out;
+  out.solid_fraction.assign(g.size(), std::numeric_limits<double>::quiet_NaN());
+  out.merged.assign(g.size(), 0);
+  const double v = g.voxel_volume();
+  for (std::size_t n = 0; n < g.size(); ++n) {
+    if (cavity[n] <= 0) continue;
+    const std::size_t root = pool_of(parent, n);
+    out.solid_fraction[n] = pool_solid[root] / (pool_cavity[root] * v);
+    if (pool_size[root] > 1) {
+      out.merged[n] = 1;
+      ++out.merged_count;
+    }
+  }
   return out;
 }
 

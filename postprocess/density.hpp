@@ -2,7 +2,7 @@
 // Density fields on the die geometry (module `post`). Grain volume is split exactly among the
 // voxels it overlaps; each voxel's solid volume is divided by the part of the voxel inside the
 // cavity, so that voxels cut by the wall are not biased low; voxels with too little cavity to
-// carry a value are merged with their fullest neighbour and flagged.
+// carry a value are pooled with their fullest neighbour, both flagged.
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
@@ -70,13 +70,14 @@ CavityVolumes cavity_fractions(const VoxelGrid& grid, const std::function<double
 
 struct CorrectedField {
   std::vector<double> solid_fraction;  // solid volume over cavity volume, NaN outside the cavity
-  std::vector<std::uint8_t> merged;    // 1 where the voxel's value comes from a merge
+  std::vector<std::uint8_t> merged;    // 1 where the voxel's value is a pool's (a sliver or its host)
   std::size_t merged_count = 0;
 };
 
 // Wall correction: solid / (cavity fraction * voxel volume). Voxels whose cavity fraction is
-// below `min_cavity` are merged with the 6-neighbour of largest cavity fraction (their solid
-// and cavity volumes pooled), never divided by nearly nothing.
+// below `min_cavity` are pooled with the 6-neighbour of largest cavity fraction, never divided
+// by nearly nothing; every voxel of a pool carries the pool's solid over its cavity, so that
+// Σ solid fraction × cavity volume is the solid in the cavity's voxels exactly.
 CorrectedField correct_for_walls(const VoxelGrid& grid, const std::vector<double>& solid,
                                  const std::vector<double>& cavity, double min_cavity);
 

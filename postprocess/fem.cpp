@@ -77,35 +77,15 @@ std::vector<Overlap> overlaps(const Tet& t, const VoxelGrid& g) {
   return out;
 }
 
-// The mean over the cube of (2 k + 1)³ voxels centred on each voxel (one axis at a time; the
-// part of a cube past the grid's edge counts as empty: the grid reaches a grain past the cavity).
-std::vector<double> box_average(const VoxelGrid& g, std::vector<double> values, int k) {
-  if (k <= 0) return values;
-  const std::array<int, 3> n = {g.nx, g.ny, g.nz};
-  for (int axis = 0; axis < 3; ++axis) {
-    std::vector<double> out(values.size(), 0.0);
-    for (int i = 0; i < g.nx; ++i)
-      for (int j = 0; j < g.ny; ++j)
-        for (int l = 0; l < g.nz; ++l) {
-          std::array<int, 3> c = {i, j, l};
-          double sum = 0;
-          const int at = c[axis];
-          for (int m = std::max(0, at - k); m <= std::min(n[axis] - 1, at + k); ++m) {
-            c[axis] = m;
-            sum += values[g.index(c[0], c[1], c[2])];
-          }
-          out[g.index(i, j, l)] = sum / (2 * k + 1);
-        }
-    values.swap(out);
-  }
-  return values;
-}
-
-// FemFill from a binned field: `solid` [m³] per voxel of `grid` (shared among the elements and
-// conserved), and the averaged solid and cavity fraction each element's ratio is taken of.
+// FemFill from a binned field: each element's share of its voxels' solid [m³] over its share of
+// their cavity, the wall correction of the density field (postprocess/density.hpp) with the
+// element for the region. A share of solid over the element's own volume would put the powder
+// between the die's wall and the mesh's chords into the elements at the wall; the ratio keeps
+// each element at the density of the cavity it covers, and the mass of that sliver is what the
+// hand-off misses (measured, fem.mass_error_rel). Nothing is averaged beyond a sub-voxel, so the
+// looser layer along the walls stays in the elements there.
 FemFill share_voxels(mesh::TetMesh m, const VoxelGrid& grid, const std::vector<double>& solid,
-                     const std::vector<double>& averaged_solid, const std::vector<double>& cavity_fraction,
-                     double material_density) {
+                     const std::vector<double>& cavity_fraction, double material_density) {
   FemFill f;
   f.sub_voxel_m = grid.voxel;
   f.material_density = material_density;
@@ -118,11 +98,6 @@ FemFill share_voxels(mesh::TetMesh m, const VoxelGrid& grid, const std::vector<d
   for (const auto& list : shares)
     for (const Overlap& o : list) covered[o.voxel] += o.volume;
 
-  // Each element's share of its voxels' solid over its share of their cavity: the wall
-  // correction of the density field (postprocess/density.hpp), with the element for the region.
-  // A share of solid alone would put the powder between the die's wall and the mesh's chords
-  // into the elements at the wall, a few micrometres of it into elements a few tenths of a
-  // millimetre thick: up to 8 % too dense on the ring.
   f.element_volume.resize(elements);
   f.element_fraction.resize(elements);
   const double voxel_volume = grid.voxel_volume();
@@ -131,23 +106,15 @@ FemFill share_voxels(mesh::TetMesh m, const VoxelGrid& grid, const std::vector<d
     double solid_share = 0, cavity_share = 0;
     for (const Overlap& o : shares[e]) {
       const double part = o.volume / covered[o.voxel];
-      solid_share += averaged_solid[o.voxel] * part;
+      solid_share += solid[o.voxel] * part;
       cavity_share += cavity_fraction[o.voxel] * voxel_volume * part;
     }
     f.element_fraction[e] = cavity_share > 0 ? solid_share / cavity_share : 0.0;
+    f.solid_volume_m3 += f.element_fraction[e] * f.element_volume[e];
   }
-  // The grains' volume in the cavity (voxels no element reaches included), conserved exactly by
-  // one scale over all elements (fill_elements in fem.hpp says what it takes back).
   for (std::size_t n = 0; n < grid.size(); ++n) {
     f.binned_solid_m3 += solid[n];
     if (covered[n] <= 0) f.outside_mesh_m3 += solid[n];
-  }
-  double held = 0;
-  for (std::size_t e = 0; e < elements; ++e) held += f.element_fraction[e] * f.element_volume[e];
-  f.mass_scale = held > 0 ? f.binned_solid_m3 / held : 1.0;
-  for (std::size_t e = 0; e < elements; ++e) {
-    f.element_fraction[e] *= f.mass_scale;
-    f.solid_volume_m3 += f.element_fraction[e] * f.element_volume[e];
   }
   f.node_fraction = average_to_nodes(f.mesh, f.element_fraction, f.element_volume);
   return f;
@@ -170,7 +137,7 @@ double tet_box_overlap(const std::array<Vec3, 4>& tet, const Vec3& lo, const Vec
 }
 
 FemFill fill_elements(mesh::TetMesh m, const std::vector<Grain>& grains, const CavityShape& cavity, double sub_voxel,
-                      double averaging_width, double material_density) {
+                      double material_density) {
   // Every grain whole, up to the table, whose plane is a voxel face (grain volume above it is
   // not in the cavity).
   double reach = 0;
@@ -180,12 +147,8 @@ FemFill fill_elements(mesh::TetMesh m, const std::vector<Grain>& grains, const C
   const VoxelGrid grid = grid_covering(lo, hi, sub_voxel, Vec3(0.5 * (lo.x() + hi.x()), 0.5 * (lo.y() + hi.y()), hi.z()));
   std::vector<double> solid;
   bin_exact(grains, grid, solid);
-  std::vector<double> cavity_fraction = cavity_fractions(grid, cavity.distance, cavity.lo, cavity.hi, 3).fraction;
-  const int half_window = int(std::lround(0.5 * averaging_width / sub_voxel));
-  FemFill f = share_voxels(std::move(m), grid, solid, box_average(grid, solid, half_window),
-                           box_average(grid, cavity_fraction, half_window), material_density);
-  f.averaging_width_m = (2 * half_window + 1) * sub_voxel;
-  return f;
+  const std::vector<double> cavity_fraction = cavity_fractions(grid, cavity.distance, cavity.lo, cavity.hi, 3).fraction;
+  return share_voxels(std::move(m), grid, solid, cavity_fraction, material_density);
 }
 
 std::vector<double> average_to_nodes(const mesh::TetMesh& m, const std::vector<double>& value,

@@ -21,11 +21,9 @@ struct FemFill {
   std::vector<double> node_fraction;    // volume-weighted mean of the elements around each node
   double material_density = 0;          // [kg/m³] of the grains' solid
   double solid_volume_m3 = 0;           // Σ fraction × volume over the elements
-  double binned_solid_m3 = 0;           // the grains' volume in the cavity (below the table), exactly binned
-  double outside_mesh_m3 = 0;           // of that, in voxels no element reaches
-  double mass_scale = 1;                // the one factor that made the two volumes above equal
+  double binned_solid_m3 = 0;           // the grains' volume below the table, exactly binned on the sub-voxels
+  double outside_mesh_m3 = 0;           // of that, in sub-voxels no element reaches
   double sub_voxel_m = 0;               // the binning voxel the element values are integrated from
-  double averaging_width_m = 0;         // the cube each voxel's solid and cavity are averaged over
 };
 
 // The cavity the mesh fills: the signed distance to its walls (positive inside) and its box,
@@ -35,20 +33,15 @@ struct CavityShape {
   Vec3 lo, hi;
 };
 
-// Each element's solid fraction from the exact binning (sphere-box volumes on voxels of edge
-// `sub_voxel`, with a face on the table's plane): each voxel's grain volume and cavity volume,
-// averaged over a cube of about `averaging_width` around it (0: not averaged), are shared among
-// the elements by their exact overlaps (tetrahedron-box clipping), and their ratio taken, as the
-// density field's wall correction takes it per voxel. Averaging keeps an element smaller than a
-// grain from reading the grain-scale structure: on the default ring 29 % of the elements hold
-// less than a fifth of a grain's volume, and without averaging 154 of 12 439 read solid
-// fractions above 0.74, up to 0.89 (with it: 0.41-0.62). Then one scale over all elements makes
-// Σ fraction × volume the grains' volume in the cavity exactly: the mesh's chords leave a sliver
-// of the cavity outside it (0.05 % of the ring's volume), and averaging carries the denser
-// interior into the thin layer at the walls that grain centres cannot reach (on the default
-// ring the scale is 0.986: every element 1.4 % lower than the averaged ratio).
+// Each element's solid fraction from the exact binning (sphere-box volumes on sub-voxels of edge
+// `sub_voxel`, with a face on the table's plane): each sub-voxel's grain volume and cavity volume
+// are shared among the elements by their exact overlaps (tetrahedron-box clipping), and each
+// element's two shares divided, as the density field's wall correction divides per voxel. No
+// averaging wider than a sub-voxel and no rescale: Σ fraction × volume differs from the grains'
+// volume in the cavity by what the mesh's chords cut off (0.05 % of the ring's volume) and the
+// sub-voxels' cavity fractions, and that difference is reported, not hidden (issue 44).
 FemFill fill_elements(mesh::TetMesh mesh, const std::vector<Grain>& grains, const CavityShape& cavity, double sub_voxel,
-                      double averaging_width, double material_density);
+                      double material_density);
 
 // The volume of a tetrahedron inside the box [lo, hi] (exact up to rounding) [m³].
 double tet_box_overlap(const std::array<Vec3, 4>& tet, const Vec3& lo, const Vec3& hi);

@@ -24,11 +24,11 @@ const KeyTable<dem::Material>& material_keys() {
       {"materials", "name", KeyType::text, "", {}, {}, Shapes::settling,
        "what [[interactions]] and the scene call it; the pipeline needs \"powder\" and \"steel\"",
        [](const M& m) -> KeyValue { return m.name; }, [](M& m, const KeyValue& v) { m.name = std::get<std::string>(v); }},
-      field<M>("materials", "density", KeyType::number, "kg/m³", {1, 1e5}, "of the solid grain material", &M::density),
-      field<M>("materials", "youngs_modulus", KeyType::number, "Pa", {1e3, 1e13},
+      field<M>("materials", "density", KeyType::number, "kg/m³", {100, 25000}, "of the solid grain material", &M::density),
+      field<M>("materials", "youngs_modulus", KeyType::number, "Pa", {1e4, 1.2e12},
                "Hertz stiffness; softened powders keep overlaps near 1 % of the radius (checked each run)", &M::youngs_modulus),
       field<M>("materials", "poisson_ratio", KeyType::number, "", {0, 0.5, false, true}, "ν, with E the Hertz E* and G*", &M::poisson_ratio),
-      field<M>("materials", "restitution", KeyType::number, "", {0, 1, true}, "of a head-on collision (damping calibrated to it)",
+      field<M>("materials", "restitution", KeyType::number, "", {0.05, 1}, "of a head-on collision (damping calibrated to it)",
                &M::restitution),
       field<M>("materials", "sliding_friction", KeyType::number, "", {0, 10}, "Coulomb coefficient μ", &M::sliding_friction),
       field<M>("materials", "rolling_friction", KeyType::number, "", {0, 1}, "μ_r: rolling torque limit μ_r R* F_n",
@@ -43,7 +43,7 @@ const KeyTable<InteractionEntry>& interaction_keys() {
   using I = InteractionEntry;
   // Besides these, `materials = ["a", "b"]` names the pair (read_materials).
   static const KeyTable<I> keys = {
-      field<I>("interactions", "restitution", KeyType::number, "", {0, 1, true}, "replaces the geometric mean",
+      field<I>("interactions", "restitution", KeyType::number, "", {0.05, 1}, "replaces the geometric mean",
                &I::restitution),
       field<I>("interactions", "sliding_friction", KeyType::number, "", {0, 10}, "replaces the geometric mean",
                &I::sliding_friction),

@@ -53,36 +53,36 @@ void add_physics_keys(KeyTable<Target>& keys, dem::ModelSpec& (*spec)(Target&), 
                     [of, get](const Target& t) -> KeyValue { return get(of(t)); },
                     [spec, set](Target& t, const KeyValue& v) { set(spec(t), v); }});
   };
-  number("contact", "linear_stiffness", KeyType::number, "N/m", {0, 1e12},
+  number("contact", "linear_stiffness", KeyType::number, "N/m", zero_or(1e-3, 1e9),
          "the real powder's spring for the linear law; coarse grains get α times it (docs/PHYSICS.md §4)",
          [](const dem::ModelSpec& s) { return s.linear_stiffness; },
          [](dem::ModelSpec& s, const KeyValue& v) { s.linear_stiffness = std::get<double>(v); });
-  number("simulation", "time_step", KeyType::number_or_auto, "s", {0, 1e-2, true},
+  number("simulation", "time_step", KeyType::number_or_auto, "s", {1e-9, 1e-3},
          "\"auto\": a fraction of the smaller of the Rayleigh and Hertz collision times",
          [](const dem::ModelSpec& s) { return s.time_step.value_or(std::numeric_limits<double>::quiet_NaN()); },
          [](dem::ModelSpec& s, const KeyValue& v) {
            const double dt = std::get<double>(v);
            s.time_step = std::isnan(dt) ? std::nullopt : std::optional<double>(dt);
          });
-  number("simulation", "time_step_fraction", KeyType::number, "", {0, 1, true},
+  number("simulation", "time_step_fraction", KeyType::number, "", {1e-3, 1},
          "of the stable limit, when the step is automatic (docs/PHYSICS.md §5)",
          [](const dem::ModelSpec& s) { return s.time_step_fraction; },
          [](dem::ModelSpec& s, const KeyValue& v) { s.time_step_fraction = std::get<double>(v); });
-  number("simulation", "max_impact_speed", KeyType::number, "m/s", {0, 100, true},
+  number("simulation", "max_impact_speed", KeyType::number, "m/s", {1e-3, 100},
          "for the Hertz collision time; the pipeline raises it to sqrt(2 g depth) + shoe speed for deeper dies",
          [](const dem::ModelSpec& s) { return s.max_impact_speed; },
          [](dem::ModelSpec& s, const KeyValue& v) { s.max_impact_speed = std::get<double>(v); });
-  number("simulation", "gravity", KeyType::vec3, "m/s²", {-1000, 1000}, "gravitational acceleration",
+  number("simulation", "gravity", KeyType::vec3, "m/s²", {-100, 100}, "gravitational acceleration",
          [](const dem::ModelSpec& s) { return s.gravity; },
          [](dem::ModelSpec& s, const KeyValue& v) { s.gravity = std::get<dem::Vec3>(v); });
-  number("simulation", "skin", KeyType::number_or_auto, "m", {0, 0.1, true},
+  number("simulation", "skin", KeyType::number_or_auto, "m", {1e-7, 0.01},
          "neighbour-list skin; \"auto\": half the largest grain radius",
          [](const dem::ModelSpec& s) { return s.skin.value_or(std::numeric_limits<double>::quiet_NaN()); },
          [](dem::ModelSpec& s, const KeyValue& v) {
            const double skin = std::get<double>(v);
            s.skin = std::isnan(skin) ? std::nullopt : std::optional<double>(skin);
          });
-  number("simulation", "stop_overlap", KeyType::number, "", {0, 1, true},
+  number("simulation", "stop_overlap", KeyType::number, "", {0.01, 0.5},
          "stop (exit status 3) when an overlap exceeds this fraction of a radius: flowing grains overlap 1-2 %, a time "
          "step past the stable limit goes far beyond",
          [](const dem::ModelSpec& s) { return s.stop_overlap; },

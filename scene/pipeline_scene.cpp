@@ -74,14 +74,14 @@ KeyTable<P> make_pipeline_keys() {
       text("die", "role", KeyType::choice, {"cavity"}, die,
            "the mesh is the part's shape, open at the die table (its highest z); `diefill sdf --role` takes tools too",
            &P::die_role),
-      number("die", "voxel_fraction", "largest grain radii", {0, 4, true}, die,
+      number("die", "voxel_fraction", "largest grain radii", {0.05, 4}, die,
              "SDF voxel edge: contacts are exact either way, finer voxels find them faster near curved walls",
              &P::die_voxel_fraction),
-      number("shoe", "length", "m", {0, metre_range_hi, true}, settling, "inside, along the motion (x)", &P::shoe_length),
-      number("shoe", "width", "m", {0, metre_range_hi, true}, settling, "inside, across the motion (y)", &P::shoe_width),
-      number("shoe", "height", "m", {0, metre_range_hi, true}, settling, "inside", &P::shoe_height),
-      number("shoe", "wall_thickness", "m", {0, 0.1, true}, settling, "of the box shoe's walls", &P::shoe_wall),
-      number("shoe", "fill_height", "m", {0, metre_range_hi, true}, settling,
+      number("shoe", "length", "m", {5e-3, metre_range_hi}, settling, "inside, along the motion (x)", &P::shoe_length),
+      number("shoe", "width", "m", {5e-3, metre_range_hi}, settling, "inside, across the motion (y)", &P::shoe_width),
+      number("shoe", "height", "m", {2e-3, metre_range_hi}, settling, "inside", &P::shoe_height),
+      number("shoe", "wall_thickness", "m", {5e-4, 0.05}, settling, "of the box shoe's walls", &P::shoe_wall),
+      number("shoe", "fill_height", "m", {1e-3, metre_range_hi}, settling,
              "powder bed in the shoe: three times what the ring takes; outflow does not depend on the head (Beverloo)",
              &P::fill_height),
       number("shoe", "clearance", "largest grain radii", {0, 10}, settling,
@@ -91,30 +91,30 @@ KeyTable<P> make_pipeline_keys() {
       number("shoe", "side_margin", "m", {0, 0.1}, settling, "kept on each side of the die when trimming", &P::side_margin),
       text("shoe", "mesh", KeyType::path, {}, settling, "a shoe mesh instead of the box (origin at its inner centre, on the table)",
            &P::shoe_mesh),
-      number("motion", "speed", "m/s", {0, 10, true}, run, "cruise speed of the shoe over the die", &P::speed),
-      number("motion", "acceleration", "m/s²", {0, 1000, true}, run, "to and from the cruise speed", &P::acceleration),
+      number("motion", "speed", "m/s", {1e-3, 10}, run, "cruise speed of the shoe over the die", &P::speed),
+      number("motion", "acceleration", "m/s²", {0.1, 1000}, run, "to and from the cruise speed", &P::acceleration),
       number("motion", "start_gap", "m", {0, metre_range_hi}, settling,
              "leading wall before the die's edge at the start (where the shoe settles)", &P::start_gap),
       number("motion", "end_gap", "m", {0, metre_range_hi}, run, "trailing wall past the die's far edge at a pass's end",
              &P::end_gap),
-      number("motion", "dwell", "s", {0, 100}, run, "at the far end before returning", &P::dwell),
-      integer("motion", "passes", {1, 100}, run, "passes over the die", &P::passes),
+      number("motion", "dwell", "s", {0, 10}, run, "at the far end before returning", &P::dwell),
+      integer("motion", "passes", {1, 20}, run, "passes over the die", &P::passes),
       flag("motion", "return", run, "the shoe comes back after each pass", &P::return_stroke),
-      number("motion", "shoe_settle_time", "s", {0, 10}, settling, "the powder settles in the shoe before it moves (cached)",
+      number("motion", "shoe_settle_time", "s", zero_or(0.01, 2), settling, "the powder settles in the shoe before it moves (cached)",
              &P::shoe_settle_time),
-      number("motion", "die_settle_time", "s", {0, 10}, run, "the die settles after the shoe has passed", &P::die_settle_time),
-      number("powder", "particle_diameter", "m", {1e-7, 0.1}, settling, "the real powder: a free-flowing atomised metal",
+      number("motion", "die_settle_time", "s", zero_or(1e-3, 2), run, "the die settles after the shoe has passed", &P::die_settle_time),
+      number("powder", "particle_diameter", "m", {1e-6, 5e-3}, settling, "the real powder: a free-flowing atomised metal",
              &P::particle_diameter),
-      number("powder", "coarse_graining", "", {1, 1e4}, settling,
+      number("powder", "coarse_graining", "", {1, 200}, settling,
              "α: simulated grains α times the real ones; Hertz forces keep bulk behaviour (docs/PHYSICS.md §4)",
              &P::coarse_graining),
-      number("powder", "diameter_spread", "", {0, 1, false, true}, settling,
+      number("powder", "diameter_spread", "", {0, 0.5}, settling,
              "relative half-width of the uniform size distribution: ±10 % keeps the packing random", &P::diameter_spread),
-      integer("powder", "max_grains", {1, 1e9}, settling, "larger α, with a warning, when the shoe would need more",
+      integer("powder", "max_grains", {100, 1e8}, settling, "larger α, with a warning, when the shoe would need more",
               &P::max_grains),
       text("powder.shape", "mesh", KeyType::path, {}, settling,
            "a grain shape: rigid multi-sphere clumps scaled to the grain diameter (volume-equivalent)", &P::shape_mesh),
-      number("powder.shape", "tolerance", "", {0, 0.5, true}, settling, "the clump's volume and Hausdorff error",
+      number("powder.shape", "tolerance", "", {0.01, 0.5}, settling, "the clump's volume and Hausdorff error",
              &P::shape_tolerance),
       text("powder.shape", "units", KeyType::choice, {"mm", "m", "in"}, settling, "the grain mesh's length unit",
            &P::shape_units),
@@ -126,12 +126,12 @@ KeyTable<P> make_pipeline_keys() {
   k.insert(k.end(), simulation.begin(), simulation.end());
   k.push_back(integer("simulation", "seed", {0, 9007199254740991.0}, settling, "of the powder's random packing", &P::seed));
   k.push_back(integer("simulation", "threads", {0, 4096}, nothing, "0: all cores; results do not depend on it", &P::threads));
-  k.push_back(number("density", "voxel", "m", {0, metre_range_hi}, run, "0: two grain diameters", &P::density_voxel));
+  k.push_back(number("density", "voxel", "m", zero_or(1e-5, 0.05), run, "0: two grain diameters", &P::density_voxel));
   k.push_back(text("density", "method", KeyType::choice, {"exact", "gaussian"}, run,
                    "exact volume split, or Gaussian coarse graining", &P::density_method));
-  k.push_back(number("density", "smoothed_width", "m", {0, metre_range_hi}, run,
+  k.push_back(number("density", "smoothed_width", "m", zero_or(1e-5, 0.05), run,
                      "the smoothed field's Gaussian width and voxel; 0: half a grain diameter", &P::density_smoothed_width));
-  k.push_back(number("fem", "element_size", "m", {0, metre_range_hi}, run,
+  k.push_back(number("fem", "element_size", "m", zero_or(1e-4, 0.05), run,
                      "the tetrahedra's largest edge in fem/fill.inp; 0: the density voxel", &P::fem_element_size));
   k.push_back(text("fem", "elements", KeyType::choice, {"linear", "quadratic", "none"}, run,
                    "C3D4, C3D10 with a node on every edge, or none: no FEM hand-off", &P::fem_elements));
@@ -141,9 +141,9 @@ KeyTable<P> make_pipeline_keys() {
                    "to the working folder)", &P::out));
   k.push_back(text("output", "cache", KeyType::text, {}, nothing, "prepared die fields and settled shoes, reused by runs "
                    "that share them; empty: DIRECTORY/.cache", &P::cache));
-  k.push_back(number("output", "snapshot_every", "s", {0, 100}, nothing, "VTU snapshots; 0: the final state only",
+  k.push_back(number("output", "snapshot_every", "s", zero_or(1e-3, 10), nothing, "VTU snapshots; 0: the final state only",
                      &P::snapshot_every));
-  k.push_back(number("output", "fill_curve_every", "s", {0, 1, true}, nothing,
+  k.push_back(number("output", "fill_curve_every", "s", {1e-4, 1}, nothing,
                      "the fill curve's sampling (fill_curve.csv: mass in the cavity against time and the shoe's position)",
                      &P::fill_curve_every));
   return k;
@@ -207,11 +207,19 @@ PipelineScene load_pipeline_scene(const std::optional<std::filesystem::path>& sc
   const std::vector<std::string> names = read_materials(root, s.spec, base);
   root.finish();
 
-  // What no single range can say.
-  if (s.fill_height > s.shoe_height) {
-    if (std::optional<Table> shoe = root.table("shoe")) shoe->fail("fill_height", "is higher than the shoe", "Lower it below shoe.height");
-    throw diefill::InputError(s.source, "shoe.fill_height", "is higher than the shoe", "Lower it below shoe.height");
-  }
+  // What no single range can say, named by the key and, where the scene file gives its table,
+  // the file and line.
+  const auto refuse = [&](const char* table, const char* key, const std::string& problem, const std::string& remedy) {
+    if (std::optional<Table> t = root.table(table)) t->fail(key, problem, remedy);
+    throw diefill::InputError(s.source, std::string(table) + "." + key, problem, remedy);
+  };
+  if (s.fill_height > s.shoe_height) refuse("shoe", "fill_height", "is higher than the shoe", "Lower it below shoe.height");
+  // Each pass starts where the last ended: without a return the shoe walks off the table.
+  if (s.passes > 1 && !s.return_stroke)
+    refuse("motion", "passes", "more than one pass needs motion.return = true", "Set motion.return = true, or one pass");
+  if (!(s.spec.gravity.z() < 0))
+    refuse("simulation", "gravity", "must point down (negative z): the powder falls into the die",
+           "Give gravity a negative z component, e.g. [0, 0, -9.81]");
   for (const char* needed : {"powder", "steel"})
     if (std::find(names.begin(), names.end(), needed) == names.end())
       root.fail("materials", std::string("must define a material named \"") + needed + "\"",

@@ -48,6 +48,7 @@ struct PipelineScene {
   dem::ModelSpec spec;                // materials "powder", "steel"; laws; gravity; time step
   std::uint64_t seed = 1;
   int threads = 0;
+  bool force = false;                 // `--force`: run a size over the limit (pipeline/preflight.hpp); no key
   // [density]
   double density_voxel = 0;           // [m]; 0: two grain diameters
   std::string density_method = "exact";

@@ -11,12 +11,24 @@ namespace app {
 
 bool ValueRange::contains(double x) const {
   if (!std::isfinite(x)) return false;
+  if (or_zero && x == 0) return true;
   const bool above = lo_open ? x > lo : x >= lo;
   const bool below = hi_open ? x < hi : x <= hi;
   return above && below;
 }
 
-std::string ValueRange::text() const { return fmt::format("{}{}, {}{}", lo_open ? "(" : "[", lo, hi, hi_open ? ")" : "]"); }
+std::string ValueRange::text() const {
+  return fmt::format("{}{}{}, {}{}", or_zero ? "0 or " : "", lo_open ? "(" : "[", lo, hi, hi_open ? ")" : "]");
+}
+
+namespace {
+// "must lie in [a, b]" or "must be 0 or lie in [a, b]".
+std::string range_rule(const ValueRange& range) {
+  ValueRange interval = range;
+  interval.or_zero = false;
+  return (range.or_zero ? "must be 0 or lie in " : "must lie in ") + interval.text();
+}
+}  // namespace
 
 std::string toml_value(const KeyValue& value, KeyType type) {
   if (const double* x = std::get_if<double>(&value)) {
@@ -73,7 +85,7 @@ void check_value(Table& where, std::string_view name, KeyType type, const ValueR
   const std::string key(name);
   const std::string in_unit = unit.empty() ? std::string() : fmt::format(" [{}]", unit);
   auto out_of_range = [&](const std::string& got) {
-    where.fail(key, fmt::format("must lie in {}{}, got {}", range.text(), in_unit, got),
+    where.fail(key, fmt::format("{}{}, got {}", range_rule(range), in_unit, got),
                fmt::format("Give a value in {} (`diefill scene` prints every key with its range)", range.text()));
   };
   switch (type) {

@@ -39,13 +39,18 @@ enum class Shapes : std::uint8_t {
   nothing,   // where and how results are written, and how fast: never the result
 };
 
-// Closed unless marked open; integers and the components of a vec3 are checked alike.
+// Closed unless marked open; integers and the components of a vec3 are checked alike. A key whose
+// 0 means "derived" or "off" (density.voxel = 0: two grain diameters) allows 0 besides the
+// interval, which starts at the smallest value that means something: an open bound at 0 lets
+// 1e-300 through, and such a value only shows as an overflow after the whole DEM (issue 44).
 struct ValueRange {
   double lo = 0, hi = 0;
   bool lo_open = false, hi_open = false;
+  bool or_zero = false;
   bool contains(double x) const;
-  std::string text() const;  // "(0, 4]"
+  std::string text() const;  // "(0, 4]", "0 or [1e-05, 0.05]"
 };
+constexpr ValueRange zero_or(double lo, double hi) { return {lo, hi, false, false, true}; }
 
 // A value as the table holds it: a number (also an integer key's, exactly), a flag, text (also a
 // choice or a path) or a 3-vector.

@@ -199,6 +199,7 @@ std::string coarse_cavity_run(const PipelineScene& scene, double diameter_over_w
   if (particles.value("in_cavity", 0) == 0) return "no grain entered the cavity";
   const auto& checked = run.report["stability"];
   // The shoe's cut lets a grain it pinches overlap by up to half the stop limit (pipeline.cpp).
+  // Grains the shoe spills over the table's edge are physical; those lost are faults.
   return run_problems(particles.value("lost", 0), checked.value("max_overlap_rel", 0.0), checked.value("max_energy_gain", 0.0),
                       0.5 * s.spec.stop_overlap);
 }

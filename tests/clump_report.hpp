@@ -15,7 +15,8 @@ inline void expect_clump_fill_census(const nlohmann::json& report) {
   EXPECT_EQ(p["lost"].get<std::int64_t>(), 0);
   EXPECT_GT(p["in_cavity"].get<std::int64_t>(), 100);
   EXPECT_EQ(p["inserted"].get<std::int64_t>(),
-            p["in_cavity"].get<std::int64_t>() + p["in_shoe"].get<std::int64_t>() + p["elsewhere"].get<std::int64_t>());
+            p["in_cavity"].get<std::int64_t>() + p["in_shoe"].get<std::int64_t>() + p["elsewhere"].get<std::int64_t>() +
+                p["spilled"].get<std::int64_t>());
   EXPECT_GT(report["powder"]["spheres_per_grain"].get<int>(), 1);
   const double d = report["powder"]["grain_diameter_m"].get<double>();
   const double expected = double(p["inserted"].get<std::int64_t>()) * std::numbers::pi / 6 * d * d * d;

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <numbers>
 #include <nlohmann/json.hpp>
 
 #include "mesh/import.hpp"
@@ -112,6 +113,34 @@ void write_scene(const test::TempDir& dir, const std::string& extra_simulation =
                                            "\n[output]\ntrajectory = true\ntrajectory_every = 0.005\nsnapshot_every = 0.005\n");
 }
 }  // namespace
+
+// Values that mean nothing and scenes too large to be meant are refused before any work, by
+// `scene` as by `run` (issue 44): within seconds, naming the key, the model's compilation
+// included; a size over the limit says how to go on, and --force accepts it.
+TEST(CliScene, RefusesWhatRunWouldBeforeAnyWork) {
+  const std::string ring = (test::source_dir() / "dies" / "ring.stl").string();
+  test::TempDir dir;
+  const auto started = std::chrono::steady_clock::now();
+  expect_bad_input("run " + ring + " --set motion.speed=1e-300 --out " + (dir / "out").string(), "motion.speed", "[0.001, 10]");
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(), 10.0);
+  EXPECT_FALSE(fs::exists(dir / "out" / "ring")) << "refused before the die was prepared";
+  expect_bad_input("scene --set contact.normal=linear --set contact.linear_stiffness=0", "contact.linear_stiffness", "linear");
+  expect_bad_input("scene --set motion.passes=2", "motion.passes", "motion.return");
+  // The shoe at 10 m/s with a skin of 0.1 µm passes grains unseen: the pass's compilation refuses
+  // it, which a run reached only after settling the shoe.
+  expect_bad_input("scene " + ring + " --set motion.speed=10 --set simulation.skin=1e-7", "walls.shoe.motion", "skin");
+  const std::string huge = " --set powder.coarse_graining=1 --set powder.max_grains=100000000";
+  expect_bad_input("scene " + ring + huge, "ring.stl", "--force");
+  const test::Run forced = test::run_diefill("scene " + ring + huge + " --force");
+  EXPECT_EQ(forced.status, 0) << forced.output;
+  // The shoe (32 mm, trimmed to the die's 20 mm and two 4 mm margins) filled 8 mm deep at 0.6 with
+  // grains of 0.1 mm.
+  const auto grains = std::size_t(32e-3 * 28e-3 * 8e-3 * 0.6 / (std::numbers::pi / 6 * 1e-12));
+  EXPECT_NE(forced.output.find(fmt::format("{} grains", grains)), std::string::npos) << forced.output;
+  const test::Run plain = test::run_diefill("scene " + ring);
+  EXPECT_EQ(plain.status, 0) << plain.output;
+  EXPECT_NE(plain.output.find("The run on ring: 16042 grains"), std::string::npos) << plain.output;
+}
 
 TEST(CliSimulate, WritesTheFilesOfTheInterface) {
   test::TempDir dir;

@@ -5,6 +5,7 @@
 #include <fmt/core.h>
 
 #include <numbers>
+#include <random>
 
 #include "mesh/die.hpp"
 #include "mesh/shapes.hpp"
@@ -248,71 +249,134 @@ TEST(FemFiles, TheTableKeepsItsFacesWhenANodeLiesNanometresAboveIt) {
   EXPECT_NEAR(area_at_or_above(m.nodes, raised.table, -1.0), opening, 1e-3 * opening);
 }
 
-TEST(FemFill, KeepsALatticeFlatUpToTheWallsAndConservesItsVolume) {
-  // An FCC lattice of 0.2 mm cells (touching spheres, φ = 0.7405) whose centres lie in the ring's
-  // cavity, on the ring's 1.6 mm elements averaged over 1.6 mm (as a run averages over its density
-  // voxel, which is also its element size). Its planes lie half a spacing from the floor and the
-  // table, so that each plane's slab ends at them: the lattice is uniform there up to the wall.
-  // The elements hold exactly the lattice's volume below the table; every element not at the
-  // open top is within 2 % of φ, those at the walls and the floor included, and those at the
-  // walls and the floor average φ within 1 % (no wall drop). (Without averaging the elements at
-  // the walls are up to 8 % off: a lattice cut at a curved wall, or by a tetrahedron a few planes
-  // thick, holds one plane more or less than its share; that is the lattice's, not the method's.)
-  const double a = 0.2e-3, r = a * std::sqrt(2.0) / 4, phi = std::numbers::pi / (3 * std::sqrt(2.0));
-  const std::vector<Vec3> basis = {Vec3(0, 0, 0), Vec3(0.5, 0.5, 0), Vec3(0.5, 0, 0.5), Vec3(0, 0.5, 0.5)};
-  std::vector<post::Grain> grains;
-  const double ro = 10e-3 * std::cos(std::numbers::pi / 104), ri = 5e-3;  // the 104-gon's inscribed radius
+namespace {
+
+// An FCC lattice of touching spheres (cells of 0.4 mm, φ = 0.7405) in the ring's cavity, every
+// sphere wholly inside it: a lattice uniform inside and a layer void of grains along every wall,
+// as grain centres keep a radius from a real wall. Its solid at a point is known exactly.
+struct WallLayerLattice {
+  static constexpr double a = 0.4e-3, r = a * 0.35355339059327373;  // a √2 / 4
+  const double ro = 10e-3 * std::cos(std::numbers::pi / 104), ri = 5e-3;  // the 104-gons' inscribed and outer radii
+  const Vec3 shift = Vec3(0.013e-3, 0.029e-3, 0.05e-3);
+  const std::array<Vec3, 4> basis = {Vec3(0, 0, 0), Vec3(0.5, 0.5, 0), Vec3(0.5, 0, 0.5), Vec3(0, 0.5, 0.5)};
+
+  bool holds(const Vec3& c) const {
+    const double rho = c.head<2>().norm();
+    return rho > ri + r && rho < ro - r && c.z() > -10e-3 + r && c.z() < 0;
+  }
+  std::vector<post::Grain> grains() const {
+    std::vector<post::Grain> out;
+    const int cells = int(std::ceil(10.5e-3 / a));
+    for (int i = -cells; i <= cells; ++i)
+      for (int j = -cells; j <= cells; ++j)
+        for (int k = -cells; k <= 2; ++k)
+          for (const Vec3& b : basis)
+            if (const Vec3 c = a * (Vec3(i, j, k) + b) + shift; holds(c)) out.push_back({c, r, 1.0});
+    return out;
+  }
+  // Whether p lies in a sphere: the nearest sites of each sub-lattice are the corners of the cell
+  // around p (a sphere reaches 0.354 of a cell).
+  bool solid_at(const Vec3& p) const {
+    const Vec3 q = (p - shift) / a;
+    for (const Vec3& b : basis) {
+      const Vec3 base = (q - b).array().floor().matrix();
+      for (int corner = 0; corner < 8; ++corner) {
+        const Vec3 c = a * (base + Vec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1) + b) + shift;
+        if ((p - c).norm() < r && holds(c)) return true;
+      }
+    }
+    return false;
+  }
+  // The ring's cavity exactly: between the two 104-gons (vertices at angle 2πk/104), under the table.
+  bool in_cavity(const Vec3& p) const {
+    const double sector = 2 * std::numbers::pi / 104;
+    const double middle = (std::floor(std::atan2(p.y(), p.x()) / sector) + 0.5) * sector;
+    const double apothem = p.x() * std::cos(middle) + p.y() * std::sin(middle);
+    return apothem <= ro && apothem >= ri * std::cos(std::numbers::pi / 104) && p.z() >= -10e-3 && p.z() <= 0;
+  }
+};
+
+}  // namespace
+
+// The FEM hand-off's elements against the truth: each element's solid fraction sampled at 2,000
+// random points of its part of the cavity (σ = 0.0098 for φ = 0.74), on the ring's 1.6 mm elements
+// from sub-voxels of 1.4 sphere radii (a run's: one grain radius). The void layer along the walls stays in the elements there
+// (an average wider than the elements, as the hand-off once took, read it as the interior: issue
+// 44): elements at the side walls and at the floor read their layers' truth to 1 % on average,
+// while that truth lies 7 % and 15 % below the interior's. Per element the hand-off adds at most
+// 0.016 RMS to the sampling's own scatter: half of what one run's packing scatters per voxel (5.8 %
+// of 0.55 between two seeds of the default ring, README), so that the hand-off's own error stays
+// below the noise it hands on. The elements hold the lattice's volume below the table
+// to the hand-off's promise (0.5 %), measured with no correction (there is none).
+TEST(FemFill, ElementsReadTheLatticeTheyHoldWallLayersIncluded) {
+  const WallLayerLattice lattice;
+  const double phi = std::numbers::pi / (3 * std::sqrt(2.0));
+  const std::vector<post::Grain> grains = lattice.grains();
   double below_table = 0;
-  for (int i = -52; i <= 52; ++i)
-    for (int j = -52; j <= 52; ++j)
-      for (int k = -52; k <= 2; ++k)
-        for (const Vec3& b : basis) {
-          const Vec3 c = a * (Vec3(i, j, k) + b) + Vec3(0.013e-3, 0.029e-3, 0.05e-3);
-          const double rho = c.head<2>().norm();
-          if (rho > ri && rho < ro && c.z() > -10e-3 && c.z() < 0) {
-            grains.push_back({c, r, 1.0});
-            const double h = std::clamp(r - c.z(), 0.0, 2 * r);  // the cap below z = 0
-            below_table += std::numbers::pi * h * h * (3 * r - h) / 3;
-          }
-        }
+  for (const post::Grain& g : grains) {
+    const double h = std::clamp(g.radius - g.centre.z(), 0.0, 2 * g.radius);  // the cap below z = 0
+    below_table += std::numbers::pi * h * h * (3 * g.radius - h) / 3;
+  }
   const mesh::PreparedDie die = mesh::prepare_die(test::source_dir() / "dies" / "ring.stl",
                                                   mesh::die_options_for_grains(0.4e-3, 0.2e-3), std::nullopt);
   const mesh::WallField walls = die.sdf.wall_field(die.solid);
   const post::CavityShape cavity{[&](const Vec3& p) { return walls.signed_distance(p); }, die.after.bbox.lo,
                                  Vec3(die.after.bbox.hi.x(), die.after.bbox.hi.y(), die.table_z)};
-  const post::FemFill f = post::fill_elements(ring_mesh(), grains, cavity, 0.2e-3, 1.6e-3, 7800);
-  // Binning is exact to 1e-9 of a sphere per voxel it touches (postprocess/sphere_box.hpp).
-  EXPECT_NEAR(f.binned_solid_m3 / below_table, 1.0, 1e-7);
-  EXPECT_NEAR(f.solid_volume_m3 / f.binned_solid_m3, 1.0, 1e-12);
-  // Per class of element (away from the walls, at the side walls, at the floor): count, volume,
-  // Σ volume × fraction, worst relative deviation.
+  const post::FemFill f = post::fill_elements(ring_mesh(), grains, cavity, 0.2e-3, 7800);
+  EXPECT_NEAR(f.binned_solid_m3 / below_table, 1.0, 1e-7);  // sphere-box volumes: 1e-9 of a sphere per voxel
+  EXPECT_NEAR(f.solid_volume_m3 / below_table, 1.0, 0.005);
+
+  // Per class of element (away from the walls, at the side walls, at the floor; those at the open
+  // top left out): Σ volume × fraction of the hand-off and of the truth, and the squared differences.
   struct Class {
     std::size_t count = 0;
-    double volume = 0, solid = 0, worst = 0;
+    double volume = 0, solid = 0, truth = 0, squared_difference = 0;
   } away, side, floor;
+  std::mt19937_64 random(1);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  constexpr int samples = 2000;
   for (std::size_t e = 0; e < f.mesh.tets.size(); ++e) {
+    const mesh::Tet& t = f.mesh.tets[e];
     double top = -1, radius_lo = 1, radius_hi = 0, bottom = 0;
-    for (int n : f.mesh.tets[e]) {
+    for (int n : t) {
       const Vec3& p = f.mesh.nodes[n];
       top = std::max(top, p.z()), bottom = std::min(bottom, p.z());
       radius_lo = std::min(radius_lo, p.head<2>().norm()), radius_hi = std::max(radius_hi, p.head<2>().norm());
     }
-    if (top > -1e-9) continue;  // at the open top
-    Class& c = bottom < -9.99e-3 ? floor : radius_lo < 5.01e-3 || radius_hi > 0.999 * ro ? side : away;
+    if (top > -1e-9) continue;
+    int inside = 0, solid = 0;
+    for (int k = 0; k < samples; ++k) {
+      std::array<double, 3> u = {unit(random), unit(random), unit(random)};
+      std::sort(u.begin(), u.end());
+      const Vec3 p = u[0] * f.mesh.nodes[t[0]] + (u[1] - u[0]) * f.mesh.nodes[t[1]] + (u[2] - u[1]) * f.mesh.nodes[t[2]] +
+                     (1 - u[2]) * f.mesh.nodes[t[3]];
+      if (!lattice.in_cavity(p)) continue;  // the chords of the inner wall reach past it
+      ++inside;
+      solid += lattice.solid_at(p);
+    }
+    const double truth = double(solid) / double(inside);
+    Class& c = bottom < -9.99e-3 ? floor : radius_lo < 5.01e-3 || radius_hi > 0.999 * lattice.ro ? side : away;
     ++c.count;
     c.volume += f.element_volume[e];
     c.solid += f.element_volume[e] * f.element_fraction[e];
-    c.worst = std::max(c.worst, std::abs(f.element_fraction[e] / phi - 1));
+    c.truth += f.element_volume[e] * truth;
+    c.squared_difference += (f.element_fraction[e] - truth) * (f.element_fraction[e] - truth);
   }
-  for (const auto& [name, c] : {std::pair{"away from the walls", away}, {"at the side walls", side}, {"at the floor", floor}})
-    std::printf("%zu elements %s: mean %.4f φ, worst %.2f %% off\n", c.count, name, c.solid / c.volume / phi, 100 * c.worst);
-  std::printf("%.3g %% of the volume in voxels outside the mesh; scale %.6f\n", 100 * f.outside_mesh_m3 / below_table, f.mass_scale);
+  const double sampling = std::sqrt(phi * (1 - phi) / samples);
+  for (const auto& [name, c] : {std::pair{"away from the walls", away}, {"at the side walls", side}, {"at the floor", floor}}) {
+    const double rms = std::sqrt(c.squared_difference / double(c.count));
+    std::printf("%zu elements %s: mean %.4f, truth %.4f (%.4f φ); RMS difference %.4f (sampling %.4f)\n", c.count, name,
+                c.solid / c.volume, c.truth / c.volume, c.truth / c.volume / phi, rms, sampling);
+    EXPECT_NEAR(c.solid / c.truth, 1.0, 0.01) << name;
+    EXPECT_LT(rms, std::hypot(sampling, 0.016)) << name;
+  }
+  std::printf("elements hold %.6f of the lattice below the table; mesh volume %.6f of the cavity\n", f.solid_volume_m3 / below_table,
+              mesh_volume(ring_mesh()) / die.after.volume_m3);
   EXPECT_GT(away.count, 300u);
   EXPECT_GT(side.count, 1000u);
   EXPECT_GT(floor.count, 200u);
-  for (const Class& c : {away, side, floor}) EXPECT_LT(c.worst, 0.02);
-  EXPECT_NEAR(side.solid / side.volume / phi, 1.0, 0.01);
-  EXPECT_NEAR(floor.solid / floor.volume / phi, 1.0, 0.01);
+  EXPECT_LT(side.truth / side.volume, 0.98 * phi) << "the lattice's wall layer must be there to be kept";
+  EXPECT_LT(floor.truth / floor.volume, 0.98 * phi);
 }
 
 TEST(Compaction, AUniformDiscGivesTheAnalyticPunchForce) {

@@ -26,11 +26,13 @@ std::string refusal(const std::string& override_text) {
   }
 }
 
-// A value just outside a range, below or above (a whole number for an integer key).
+// A value just outside a range, below or above (a whole number for an integer key); for a range
+// that allows 0 besides its interval, the gap between them and a negative value too.
 std::vector<double> outside(const app::ValueRange& r, app::KeyType type) {
   if (type == app::KeyType::integer) return {r.lo - 1, r.hi + 1};
   const double below = r.lo_open ? r.lo : r.lo - std::max(1.0, std::abs(r.lo)) * 1e-3;
   const double above = r.hi_open ? r.hi : r.hi + std::max(1.0, std::abs(r.hi)) * 1e-3;
+  if (r.or_zero) return {0.5 * r.lo, -r.lo, above};
   return {below, above};
 }
 
@@ -73,9 +75,13 @@ TEST(SceneKeys, EveryNumberOutsideItsRangeIsRefusedNamingTheKey) {
   EXPECT_GT(checked, 60);
 }
 
-// The values the review found loading without a word, or refused under the wrong name.
+// The values the reviews found loading without a word, or refused under the wrong name: each
+// key's lowest meaningful value is its bound (issue 44: 1e-300 ran the whole DEM, or for ever).
 TEST(SceneKeys, AbsurdValuesFoundByTheReviewAreRefusedByName) {
-  EXPECT_NE(refusal("powder.particle_diameter=1e-300").find("powder.particle_diameter"), std::string::npos);
+  for (const char* key : {"powder.particle_diameter", "motion.speed", "motion.acceleration", "density.voxel",
+                          "density.smoothed_width", "fem.element_size", "simulation.time_step", "die.voxel_fraction",
+                          "output.fill_curve_every", "output.snapshot_every", "simulation.skin", "motion.die_settle_time"})
+    EXPECT_NE(refusal(std::string(key) + "=1e-300").find(key), std::string::npos) << key;
   test::TempDir dir;
   for (const char* line : {"rolling_friction = 1e308", "density = 1e-300", "youngs_modulus = -1"}) {
     test::write_text(dir / "scene.toml", fmt::format("[[materials]]\nname = \"powder\"\n{}\n\n[[materials]]\nname = \"steel\"\n", line));

@@ -1,0 +1,81 @@
+#include "pipeline/preflight.hpp"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+
+namespace app {
+
+namespace {
+
+// Two grains, the smallest and the largest the size distribution draws: the model's time step is
+// the smallest Rayleigh and collision time over its grains, and its skin follows the largest.
+dem::Model compile_on_stand_ins(const dem::ModelSpec& spec, double diameter, double spread, const std::string& source) {
+  const int powder = material_named(spec, "powder");
+  dem::State stand_ins;
+  const double density = spec.materials[std::size_t(powder)].density;
+  stand_ins.add_sphere(0, dem::Vec3::Zero(), 0.5 * diameter * (1 - spread), density, powder);
+  stand_ins.add_sphere(1, dem::Vec3::UnitX(), 0.5 * diameter * (1 + spread), density, powder);
+  return dem::compile_model(spec, stand_ins, source);
+}
+
+std::size_t steps_of(double duration, double dt) { return std::size_t(std::llround(duration / dt)); }
+
+}  // namespace
+
+dem::ModelSpec fill_laws(const PipelineScene& s, const GrainSizing& grains, double die_depth) {
+  dem::ModelSpec spec = coarse_grained_spec(s.spec, grains.alpha);
+  spec.max_impact_speed = std::max(spec.max_impact_speed, std::sqrt(2 * spec.gravity.norm() * die_depth) + s.speed);
+  return spec;
+}
+
+RunSize preflight(const PipelineScene& s, const DieSource& die, const ShoePlan& shoe, const GrainSizing& grains) {
+  RunSize size;
+  size.grains = grains.count;
+  // The settling sees the scene's impact speed; the pass the raised one and the shoe's motion.
+  const dem::Model settling = compile_on_stand_ins(coarse_grained_spec(s.spec, grains.alpha), grains.diameter, s.diameter_spread, s.source);
+  const dem::ModelSpec pass_laws = fill_laws(s, grains, die.box.size().z());
+  if (pass_laws.max_impact_speed > s.spec.max_impact_speed)
+    diefill::log::info("{}: impacts reach {:.3g} m/s in this die; time step set for them (simulation.max_impact_speed is {:.3g})",
+                       die.file.name, pass_laws.max_impact_speed, s.spec.max_impact_speed);
+  const dem::Model pass = compile_on_stand_ins(pass_laws, grains.diameter, s.diameter_spread, s.source);
+  dem::check_wall_travel("shoe", shoe.motion.top_speed(), pass.dt, pass.skin, s.source);
+  size.settling_dt_s = settling.dt;
+  size.pass_dt_s = pass.dt;
+  size.settling_steps = steps_of(s.shoe_settle_time, settling.dt);
+  size.pass_steps = steps_of(shoe.t_motion + s.die_settle_time, pass.dt);
+  size.particle_steps =
+      double(size.grains) * (double(size.pass_steps) + double(max_insertion_rounds) * double(size.settling_steps));
+  return size;
+}
+
+void preflight_laws(const PipelineScene& s) {
+  compile_on_stand_ins(coarse_grained_spec(s.spec, s.coarse_graining), s.grain_diameter(), s.diameter_spread, s.source);
+}
+
+void refuse_oversized(const PipelineScene& s, const RunSize& size, const std::string& source) {
+  if (size.particle_steps <= particle_step_limit || s.force) return;
+  throw diefill::InputError(
+      source, "run size",
+      fmt::format("the run would take about {:.2g} particle-steps ({} grains, {} steps of {:.3g} s for the pass and up to {} of "
+                  "{:.3g} s settling the shoe), over the limit of {:.2g} (10³ times the default ring run's)",
+                  size.particle_steps, size.grains, size.pass_steps, size.pass_dt_s,
+                  std::size_t(max_insertion_rounds) * size.settling_steps, size.settling_dt_s, particle_step_limit),
+      "Coarsen the grains (powder.coarse_graining, powder.max_grains), shorten the motion (motion.speed, motion.passes, "
+      "the settle times), or pass --force to run it anyway");
+}
+
+std::string describe_size(const RunSize& size, const std::string& die_name) {
+  return fmt::format(
+      "\n# The run on {}: {} grains. The shoe settles in up to {} rounds of {} steps of {:.3g} s (none when its\n"
+      "# settled powder is cached); the pass and the die's settling take {} steps of {:.3g} s. In all about\n"
+      "# {:.2g} particle-steps at most (refused over {:.2g}, 10³ times the default ring run's, unless --force).\n",
+      die_name, size.grains, max_insertion_rounds, size.settling_steps, size.settling_dt_s, size.pass_steps, size.pass_dt_s,
+      size.particle_steps, particle_step_limit);
+}
+
+}  // namespace app
