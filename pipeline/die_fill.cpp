@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include "core/error.hpp"
+#include "core/log.hpp"
 #include "core/timer.hpp"
 #include "dem/distributed.hpp"
 #include "pipeline/census.hpp"
@@ -52,6 +53,8 @@ FillWalls walls_rank0_first(const PipelineScene& s, const DieSource& source, con
 DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resume, const std::shared_ptr<dem::Exchange>& ranks) {
   diefill::Stopwatch clock;
   const ThreadCount threads(s.threads);
+  if (s.max_steps > 0)
+    diefill::log::warn("a smoke run: every DEM stage ends after at most {} steps; its outputs are no fill", s.max_steps);
   const DieSource source = read_die(s, die_mesh);
   ShoePlan shoe = plan_shoe(s, source);
   const GrainSizing grains = size_grains(s, shoe, source.file.name);

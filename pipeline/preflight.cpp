@@ -33,7 +33,40 @@ dem::ModelSpec fill_laws(const PipelineScene& s, const GrainSizing& grains, doub
   return spec;
 }
 
+namespace {
+
+// The grids the outputs bin on, each refused (InputError naming its key) when it would hold more
+// voxels than the limit: the density field, the smoothed field, the FEM hand-off's sub-voxels.
+void check_grids(const PipelineScene& s, const DieSource& die, const GrainSizing& grains) {
+  const double density_voxel = s.density_voxel > 0 ? s.density_voxel : 2 * grains.diameter;
+  const double element = s.fem_element_size > 0 ? s.fem_element_size : density_voxel;
+  const struct {
+    const char* key;
+    double voxel;
+    const char* remedy;
+  } grids[] = {{"density.voxel", density_voxel, "Give a coarser density.voxel"},
+               {"density.smoothed_width", s.density_smoothed_width > 0 ? s.density_smoothed_width : 0.5 * grains.diameter,
+                "Give a coarser density.smoothed_width"},
+               {"fem.element_size", s.fem_elements == "none" ? 0.0 : std::min(0.25 * grains.diameter, 0.125 * element),
+                "Give larger elements (fem.element_size; the hand-off's sub-voxels are an eighth of one at most), or set "
+                "fem.elements = \"none\""}};
+  for (const auto& g : grids) {
+    if (g.voxel <= 0) continue;
+    const Eigen::Array3d cells = (die.box.size().array() / g.voxel).ceil() + 7;  // a few voxels of margin and kernel
+    if (const double voxels = cells.prod(); voxels > voxel_limit)
+      throw diefill::InputError(s.source, g.key,
+                                fmt::format("voxels of {:.3g} mm over the die ({:.3g} x {:.3g} x {:.3g} mm) make {:.2g} voxels, "
+                                            "over the {:.2g} a grid may hold",
+                                            g.voxel * 1e3, die.box.size().x() * 1e3, die.box.size().y() * 1e3,
+                                            die.box.size().z() * 1e3, voxels, voxel_limit),
+                                g.remedy);
+  }
+}
+
+}  // namespace
+
 RunSize preflight(const PipelineScene& s, const DieSource& die, const ShoePlan& shoe, const GrainSizing& grains) {
+  check_grids(s, die, grains);
   RunSize size;
   size.grains = grains.count;
   // The settling sees the scene's impact speed; the pass the raised one and the shoe's motion.

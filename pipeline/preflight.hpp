@@ -25,6 +25,8 @@ struct RunSize {
 // A run of more particle-steps is refused unless forced: 10³ times the default ring run's at most
 // (16 042 grains × (79 955 + 4 × 9 692) steps = 1.9·10⁹, about two minutes on two cores).
 inline constexpr double particle_step_limit = 2e12;
+// The most voxels an output grid may hold: each takes a few tens of bytes over the stages.
+inline constexpr double voxel_limit = 2e8;
 
 // Compiles the settling's and the pass's models on stand-in grains (the smallest and the
 // largest), so that every check the run's compilation makes, the shoe's travel per step

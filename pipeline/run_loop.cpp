@@ -57,7 +57,7 @@ LoopResult run_until(const dem::Model& model, dem::State& s, const LoopOptions& 
       next_output[k] = first_output_after_resume(origin, o.outputs[k].every, s.time, model.dt);
   const std::int64_t grains = s.exchange ? s.exchange->sum(std::int64_t(s.owned())) : std::int64_t(s.size());
   if (!o.resumed) s.loop_max_overlap_rel = s.loop_max_energy_gain = 0;
-  while (s.time < o.until - 0.5 * model.dt) {
+  while (s.time < o.until - 0.5 * model.dt && (o.max_steps == 0 || result.steps < o.max_steps)) {
     bool output = false;
     for (std::size_t k = 0; k < o.outputs.size(); ++k)
       if (s.time >= origin + double(next_output[k]) * o.outputs[k].every - 0.5 * model.dt) {

@@ -38,6 +38,9 @@ struct LoopOptions {
   // Where the outputs' cadence starts (Periodic); a resumed loop passes the interrupted one's
   // start. Unset: the state's time when the loop starts.
   std::optional<double> output_origin;
+  // A smoke run's bound (PipelineScene::max_steps): the loop ends after this many steps, with
+  // its closing outputs, as if it had reached `until`. 0: none.
+  std::int64_t max_steps = 0;
 };
 
 // The first output of a cadence (`every` from `origin`) that a loop resumed at `time` has still

@@ -110,6 +110,7 @@ bool settle(const Insertion& in, dem::State& bed, const std::string& label) {
   LoopOptions loop;
   loop.until = in.scene.shoe_settle_time;
   loop.label = label;
+  loop.max_steps = in.scene.max_steps;
   return !run_until(model, bed, loop).interrupted;
 }
 
@@ -156,10 +157,12 @@ void expect_same_template_on_every_rank(const mesh::ClumpTemplate& clump, dem::E
 }  // namespace
 
 std::string settled_shoe_key(const PipelineScene& s, const SettledShoeInputs& in, std::string_view dem_source_hash) {
-  return diefill::sha256_hex(fmt::format("settled shoe v3;{};{};{}{};{:a};{:a};{};{:a};{:a};{:a};{:a};{:a};{}", dem_source_hash,
+  // A smoke run's shoe (PipelineScene::max_steps) is not settled: it is never a real run's.
+  return diefill::sha256_hex(fmt::format("settled shoe v3;{};{};{}{};{:a};{:a};{};{:a};{:a};{:a};{:a};{:a};{};{}", dem_source_hash,
                                          in.die_cache_key, shaping_values(pipeline_keys(), Shapes::settling, s),
                                          describe_materials(s.spec), in.grains.diameter, in.grains.r_max, in.grains.count,
-                                         in.shoe.length, in.shoe.width, in.shoe.x_start, in.shoe.y_centre, in.table_z, in.powder));
+                                         in.shoe.length, in.shoe.width, in.shoe.x_start, in.shoe.y_centre, in.table_z, in.powder,
+                                         s.max_steps));
 }
 
 std::optional<SettledShoe> fill_and_settle_shoe(const PipelineScene& s, const FillWalls& walls, const GrainSizing& grains,

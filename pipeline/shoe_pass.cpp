@@ -116,6 +116,7 @@ std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& wal
   const mesh::TriMesh shoe_surface = surface_of(*walls.shoe_field);
   LoopOptions loop;
   loop.until = shoe.t_motion + s.die_settle_time;
+  loop.max_steps = s.max_steps;
   loop.label = walls.die.name + ": filling";
   loop.checkpoint = checkpoint;
   loop.resumed = resume && found;

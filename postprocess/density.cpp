@@ -5,11 +5,21 @@
 #include <limits>
 #include <numbers>
 
+#include <fmt/core.h>
+
+#include "core/error.hpp"
 #include "postprocess/sphere_box.hpp"
 
 namespace post {
 
 VoxelGrid grid_covering(const Vec3& lo, const Vec3& hi, double h, const Vec3& anchor) {
+  // Scenes bound their voxels (pipeline/preflight.hpp); this catches any other caller before a
+  // count overflows an int.
+  if (!(h > 0) || !((hi - lo).maxCoeff() / h < 1e6))
+    throw diefill::InputError("density", "voxel",
+                              fmt::format("voxels of {:.3g} m over {:.3g} m would be over a million along one axis",
+                                          h, (hi - lo).maxCoeff()),
+                              "Give a coarser voxel");
   VoxelGrid g;
   g.voxel = h;
   const Vec3 face = anchor - Vec3(0.5 * h, 0.5 * h, 0);

@@ -22,6 +22,7 @@
 #include "dem/step.hpp"
 #include "dem/walls.hpp"
 #include "mesh/die.hpp"
+#include "mesh/exact.hpp"
 #include "mesh/import.hpp"
 #include "mesh/shapes.hpp"
 
@@ -161,9 +162,11 @@ std::string voxel_run(const Powder& powder, double voxel_over_radius, const std:
   const dem::Model model = dem::compile_model(spec, state, powder.source);
   dem::initialize(model, state);
   const LoopResult run = advance(model, state, 0.12, fmt::format("stability: voxel {:.3g} grain radii", voxel_over_radius));
+  // Judged by Embree's exact inside test on the die's solid, not by the wall field the contacts
+  // used: a wrong sign that let a grain in would also say it is outside.
+  const mesh::ExactSurface solid(die.solid);
   std::size_t inside = 0;
-  for (std::size_t i = 0; i < state.size(); ++i)
-    inside += state.active[i] && field->signed_distance(state.x[i]) < 0;
+  for (std::size_t i = 0; i < state.size(); ++i) inside += state.active[i] && solid.inside(state.x[i]);
   if (inside > 0) return fmt::format("{} grain centres inside the die", inside);
   const double drop = region.box.hi.z() - box.lo.z();  // from the top of the pour to the die's floor
   return settled_result_problems(state, run, impact_overlap_bound(powder, fall_speed(powder, drop)));

@@ -129,7 +129,7 @@ TEST(CliScene, RefusesWhatRunWouldBeforeAnyWork) {
   // The shoe at 10 m/s with a skin of 0.1 µm passes grains unseen: the pass's compilation refuses
   // it, which a run reached only after settling the shoe.
   expect_bad_input("scene " + ring + " --set motion.speed=10 --set simulation.skin=1e-7", "walls.shoe.motion", "skin");
-  const std::string huge = " --set powder.coarse_graining=1 --set powder.max_grains=100000000";
+  const std::string huge = " --set powder.coarse_graining=1 --set powder.max_grains=100000000 --set fem.elements=none";
   expect_bad_input("scene " + ring + huge, "ring.stl", "--force");
   const test::Run forced = test::run_diefill("scene " + ring + huge + " --force");
   EXPECT_EQ(forced.status, 0) << forced.output;
