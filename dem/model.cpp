@@ -184,8 +184,8 @@ Model compile_model(const ModelSpec& spec, const State& state, const std::string
   // The walls' motion is part of the model: a checkpoint resumes only under the same one.
   const auto vec = [](const Vec3& v) { return fmt::format("{:a},{:a},{:a}", v.x(), v.y(), v.z()); };
   for (const MeshWall& w : m.meshes) {
-    text += fmt::format(";mesh{},{},{},{},{:a},{:a}", w.name, w.field->triangles.size(), w.field->voxel, w.material,
-                        w.cut_z, w.cut_fraction);
+    text += fmt::format(";mesh{},{},{},{},{:a},{:a},{:a}", w.name, w.field->triangles.size(), w.field->voxel, w.material,
+                        w.cut_z, w.cut_fraction, w.cut_cap);
     text += fmt::format(";motion{};{};{};{}", vec(w.motion.start_position), vec(w.motion.start_velocity),
                         vec(w.motion.angular_velocity), vec(w.motion.pivot));
     for (const Motion::Segment& seg : w.motion.segments) text += fmt::format(";{:a},{}", seg.duration, vec(seg.acceleration));

@@ -50,8 +50,10 @@ int wall_hits(const Model& model, double time, const Vec3& x, double r, WallHit*
       const Vec3 normal = moving ? Vec3(q * minima[k].normal) : minima[k].normal;
       // Overlap no deeper than the centre's height above the cut: the push fades to nothing at
       // the cut, so a grain that was passed under and rises meets no sudden force, and a grain
-      // pinched at the rim is cut rather than crushed.
-      const double distance = std::max(minima[k].distance, r - height_above_cut);
+      // pinched at the rim is cut rather than crushed; in the bottom layer no deeper than the
+      // cap, which rises with the height from a radius above the cut on (model.hpp, MeshWall).
+      const double deepest = std::min(height_above_cut, wall.cut_cap * r + std::max(0.0, height_above_cut - r));
+      const double distance = std::max(minima[k].distance, r - deepest);
       const Vec3 point = x - distance * normal;
       out[count++] = {std::int32_t(model.planes.size() + m), normal, distance, point,
                       moving ? wall.motion.point_velocity(time, point) : Vec3(Vec3::Zero()),

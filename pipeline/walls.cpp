@@ -82,6 +82,8 @@ dem::ModelSpec fill_spec(const PipelineScene& s, const FillWalls& w, const DieSo
   // (cut at half a radius, a pinched grain reached the limit in one run in ten at 1.6 mm).
   shoe_wall.cut_z = source.table_z;
   shoe_wall.cut_fraction = 1 - 0.5 * spec.stop_overlap;
+  // A pinched pair overlaps about twice as deep as the wall presses (model.hpp): at half the stop limit.
+  shoe_wall.cut_cap = 0.25 * spec.stop_overlap;
   spec.meshes.push_back(shoe_wall);
   return spec;
 }
