@@ -56,7 +56,7 @@ int run_density(const DensityCommand& c) {
   if (c.fem) {
     FemSettings fem = fem_settings(2 * r_max, s.voxel_m, c.element_size_mm * 1e-3);
     fem.quadratic = c.elements == "quadratic";
-    report["fem"] = write_fem_outputs(grains, die, walls, material_density, result.stats.mass_kg, fem, out.path());
+    report["fem"] = write_fem_outputs({grains}, die, walls, material_density, result.stats.mass_kg, fem, out.path());
   }
   diefill::write_file_atomic(out / "density.json", report.dump(2) + "\n");
   out.commit();

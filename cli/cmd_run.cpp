@@ -11,6 +11,7 @@
 #include "cli/mpi_session.hpp"
 #include "pipeline/compare.hpp"
 #include "pipeline/die_fill.hpp"
+#include "pipeline/ensemble.hpp"
 #include "pipeline/preflight.hpp"
 #include "pipeline/sweep.hpp"
 #include "pipeline/run_loop.hpp"
@@ -35,7 +36,6 @@ PipelineScene scene_for(const fs::path& target, const std::vector<std::string>& 
 void apply_command_line(PipelineScene& scene, const RunCommand& c) {
   if (!c.out.empty()) scene.out = c.out;
   if (c.threads) scene.threads = *c.threads;
-  if (c.seed) scene.seed = *c.seed;
   if (c.up) scene.die_up = *c.up;
   if (c.units) scene.die_units = *c.units;
   scene.force = c.force;
@@ -85,6 +85,31 @@ std::string resume_command(const RunCommand& c, const fs::path& out) {
   return line + " --resume";
 }
 
+// The scene a command's overrides and options give, with more overrides (a sweep's case, an
+// ensemble's seed) after them: --seed is simulation.seed after the --set, before those.
+PipelineScene command_scene(const RunCommand& c, const std::vector<std::string>& more) {
+  std::vector<std::string> overrides = c.overrides;
+  if (c.seed) overrides.push_back(fmt::format("simulation.seed={}", *c.seed));
+  overrides.insert(overrides.end(), more.begin(), more.end());
+  PipelineScene scene = scene_for(c.target, overrides);
+  apply_command_line(scene, c);
+  return scene;
+}
+
+int run_seed_ensemble(const RunCommand& c, const std::shared_ptr<dem::Exchange>& ranks) {
+  if (fs::is_directory(c.target) || c.sweep || c.resume)
+    throw diefill::InputError("--seeds", c.sweep ? "--sweep" : c.resume ? "--resume" : c.target.string(),
+                              "a seed ensemble runs one die, afresh", "Give one die mesh or scene, without --sweep or --resume");
+  const DieRun run = run_ensemble([&](const std::vector<std::string>& more) { return command_scene(c, more); }, c.seeds, ranks);
+  const bool root = !ranks || ranks->rank() == 0;
+  if (run.interrupted) {
+    if (root) fmt::print(stderr, "interrupted; a seed ensemble does not resume: rerun the command\n");
+    return diefill::exit_interrupted;
+  }
+  if (root) fmt::print("{}: {} seeds, report {}\n", run.die, c.seeds, (run.dir / "report.json").string());
+  return 0;
+}
+
 }  // namespace
 
 int run_scene(const SceneCommand& c) {
@@ -116,18 +141,13 @@ int run_pipeline(const RunCommand& c) {
   // Under mpirun every rank runs this; rank 0 reports (pipeline/die_fill.hpp).
   const std::shared_ptr<dem::Exchange> ranks = mpi_exchange();
   const bool root = !ranks || ranks->rank() == 0;
+  if (c.seeds != 1) return run_seed_ensemble(c, ranks);
   if (c.sweep) {
     if (fs::is_directory(c.target))
       throw diefill::InputError(c.target.string(), "--sweep", "sweeps one die, not a folder", "Give a die mesh or a scene");
     if (c.resume)
       throw diefill::InputError("--sweep", "--resume", "a sweep does not resume", "Resume the interrupted case with `diefill run` and its --set");
-    const auto load = [&](const std::vector<std::string>& more) {
-      std::vector<std::string> overrides = c.overrides;
-      overrides.insert(overrides.end(), more.begin(), more.end());
-      PipelineScene scene = scene_for(c.target, overrides);
-      apply_command_line(scene, c);
-      return scene;
-    };
+    const auto load = [&](const std::vector<std::string>& more) { return command_scene(c, more); };
     const std::vector<DieRun> runs = run_sweep(load, parse_sweep(*c.sweep), ranks);
     if (!runs.empty() && runs.back().interrupted) return diefill::exit_interrupted;
     if (root)
@@ -136,8 +156,7 @@ int run_pipeline(const RunCommand& c) {
     return 0;
   }
   if (!fs::is_directory(c.target)) {
-    PipelineScene scene = scene_for(c.target, c.overrides);
-    apply_command_line(scene, c);
+    const PipelineScene scene = command_scene(c, {});
     if (scene.die.empty())
       throw diefill::InputError(c.target.string(), "die.file", "names no die", "Give [die] file = \"...\" or run a mesh");
     const DieRun run = run_die_fill(scene, scene.die, c.resume, ranks);
@@ -154,8 +173,9 @@ int run_pipeline(const RunCommand& c) {
     return stop_requested() ? diefill::exit_interrupted : 0;
   }
   // A folder: every mesh into its own folder, then a summary table.
-  PipelineScene scene = scene_for({}, c.overrides);
-  apply_command_line(scene, c);
+  RunCommand folder = c;
+  folder.target.clear();  // the folder holds dies, not a scene
+  const PipelineScene scene = command_scene(folder, {});
   std::string csv = "die,status,grains_in_cavity,fill_ratio,solid_fraction_mean,solid_fraction_std,solid_fraction_min,solid_fraction_max,message\n";
   std::string md = "| die | status | grains in cavity | fill ratio | mean | std | min | max |\n|---|---|---|---|---|---|---|---|\n";
   int refused = 0, unstable = 0;

@@ -40,6 +40,7 @@ struct RunCommand {
   std::optional<std::string> units;  // die.units
   bool resume = false;
   bool force = false;  // a size over the limit runs (pipeline/preflight.hpp)
+  int seeds = 1;       // > 1: a seed ensemble (pipeline/ensemble.hpp)
   std::optional<std::string> sweep;  // KEY=V1,V2,...: one run per value (pipeline/sweep.hpp)
 };
 int run_pipeline(const RunCommand& command);

@@ -50,6 +50,9 @@ void add_run(CLI::App& root, app::RunCommand& c, std::function<int()>& action) {
   cmd->add_option("--units", c.units, "Length unit of the die's file: mm, m, in, or auto (die.units)");
   cmd->add_flag("--resume", c.resume, "Continue an interrupted run from its checkpoint");
   cmd->add_flag("--force", c.force, "Run a scene whose size is over the limit (10³ times the default ring run's work)");
+  cmd->add_option("--seeds", c.seeds,
+                  "Run N seeds (from --seed or simulation.seed on), each into OUT/simulation.seed=K/, and their mean with "
+                  "its standard error into OUT/<die name>/");
   cmd->add_option("--sweep", c.sweep,
                   "Run once per value of a scene key, each into OUT/KEY=VALUE/, with a summary table and chart: "
                   "--sweep motion.speed=0.05,0.1,0.2");

@@ -7,6 +7,7 @@
 #include "core/log.hpp"
 #include "mesh/exact.hpp"
 #include "pipeline/pictures.hpp"
+#include "postprocess/ensemble_stats.hpp"
 
 namespace app {
 
@@ -133,6 +134,51 @@ DensityResult compute_density(const std::vector<post::Grain>& grains, const mesh
                                             fill_regions(fine.grid, c.centre, c.lo.z(), c.hi.z(), 2 * largest_radius, distance_to_wall));
   r.outlines = outlines_of(die.cavity, c, s.voxel_m);
   return r;
+}
+
+namespace {
+
+post::DensityField mean_field(const std::vector<const post::DensityField*>& seeds) {
+  post::DensityField mean = *seeds.front();
+  std::vector<std::vector<double>> solids, fractions, columns;
+  for (const post::DensityField* f : seeds) {
+    if (f->grid.size() != mean.grid.size() || f->grid.voxel != mean.grid.voxel || f->cavity != mean.cavity)
+      throw std::logic_error("a seed ensemble's fields lie on different grids or cavities");
+    solids.push_back(f->solid);
+    fractions.push_back(f->corrected.solid_fraction);
+    columns.push_back(post::column_means(*f));
+  }
+  mean.solid = post::mean_and_error(solids).mean;
+  post::MeanAndError phi = post::mean_and_error(fractions);
+  mean.corrected.solid_fraction = std::move(phi.mean);
+  mean.solid_fraction_stderr = std::move(phi.error);
+  mean.column_stderr = post::mean_and_error(columns).error;
+  return mean;
+}
+
+}  // namespace
+
+DensityResult mean_density(const std::vector<DensityResult>& seeds) {
+  std::vector<const post::DensityField*> fields, smoothed;
+  for (const DensityResult& r : seeds) {
+    fields.push_back(&r.field);
+    if (r.smoothed) smoothed.push_back(&*r.smoothed);
+  }
+  DensityResult mean;
+  mean.field = mean_field(fields);
+  mean.stats = post::statistics(mean.field);
+  mean.stats.regions = seeds.front().stats.regions;
+  for (std::size_t k = 0; k < mean.stats.regions.size(); ++k) {
+    double sum = 0;
+    for (const DensityResult& r : seeds) sum += r.stats.regions[k].fill_ratio;
+    mean.stats.regions[k].fill_ratio = sum / double(seeds.size());
+  }
+  if (smoothed.size() == seeds.size()) {
+    mean.smoothed = mean_field(smoothed);
+    mean.smoothed_stats = post::statistics(*mean.smoothed);
+  }
+  mean.outlines = seeds.front().outlines;
+  return mean;
 }
 
 nlohmann::json statistics_json(const post::FieldStatistics& st) {

@@ -47,6 +47,12 @@ DensityResult compute_density(const std::vector<post::Grain>& grains, const mesh
                               const mesh::WallField& walls, double material_density, const DensitySettings& settings,
                               const std::string& particles_source);
 
+// A seed ensemble's field (pipeline/ensemble.hpp): its seeds' fields, on one grid and one cavity
+// (the same die, scene and grain size), averaged voxel by voxel, with the standard error of the
+// mean per voxel and per column; its statistics and profiles are the mean field's, its regions'
+// fill ratios the seeds' means.
+DensityResult mean_density(const std::vector<DensityResult>& seeds);
+
 nlohmann::json statistics_json(const post::FieldStatistics& stats);
 
 // density.vdb, density.vti, plot_data.json and the pictures into `dir` (a staging folder).

@@ -50,18 +50,26 @@ FillWalls walls_rank0_first(const PipelineScene& s, const DieSource& source, con
 
 }  // namespace
 
+FillSetup set_up_fill(const PipelineScene& s, const fs::path& die_mesh, const std::shared_ptr<dem::Exchange>& ranks) {
+  DieSource source = read_die(s, die_mesh);
+  ShoePlan shoe = plan_shoe(s, source);
+  const GrainSizing grains = size_grains(s, shoe, source.file.name);
+  set_clearance(s, grains, source.table_z, shoe);
+  refuse_oversized(s, preflight(s, source, shoe, grains), source.file.source);
+  FillWalls walls = walls_rank0_first(s, source, grains, shoe, ranks);
+  return {std::move(source), std::move(shoe), grains, std::move(walls)};
+}
+
 DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resume, const std::shared_ptr<dem::Exchange>& ranks) {
   diefill::Stopwatch clock;
   const ThreadCount threads(s.threads);
   if (s.max_steps > 0)
     diefill::log::warn("a smoke run: every DEM stage ends after at most {} steps; its outputs are no fill", s.max_steps);
-  const DieSource source = read_die(s, die_mesh);
-  ShoePlan shoe = plan_shoe(s, source);
-  const GrainSizing grains = size_grains(s, shoe, source.file.name);
-  set_clearance(s, grains, source.table_z, shoe);
-  refuse_oversized(s, preflight(s, source, shoe, grains), source.file.source);
-  const FillWalls walls = walls_rank0_first(s, source, grains, shoe, ranks);
-  DieRun run{walls.die.name, {}, s.out / walls.die.name, false};
+  const FillSetup setup = set_up_fill(s, die_mesh, ranks);
+  const auto& [source, shoe, grains, walls] = setup;
+  DieRun run;
+  run.die = walls.die.name;
+  run.dir = s.out / run.die;
   fs::create_directories(run.dir);
 
   const std::optional<SettledShoe> settled = fill_and_settle_shoe(s, walls, grains, shoe, source.table_z, ranks);
@@ -80,6 +88,8 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
   check_losses(census, source.file.source, walls.die.name);
   const FillRecord record{s, walls, grains, shoe, *settled, *fill, census, source.table_z, clock.seconds(), ranks ? ranks->ranks() : 1};
   run.report = write_fill_outputs(record, run.dir);
+  run.cavity_grains = census.cavity;
+  run.fill_curve = fill->curve;
   return run;
 }
 

@@ -9,6 +9,9 @@
 #include <string>
 
 #include "dem/exchange.hpp"
+#include "pipeline/fill_curve.hpp"
+#include "pipeline/walls.hpp"
+#include "postprocess/density.hpp"
 #include "scene/pipeline_scene.hpp"
 
 namespace app {
@@ -18,7 +21,22 @@ struct DieRun {
   nlohmann::json report;     // report.json as written
   std::filesystem::path dir;
   bool interrupted = false;  // Ctrl-C: a checkpoint (or nothing, while the shoe settled) was kept
+  // What a seed ensemble combines (pipeline/ensemble.hpp): the grains in the cavity at the end,
+  // as they were binned, and the fill curve (rank 0's; empty on the others).
+  std::vector<post::Grain> cavity_grains;
+  std::vector<FillSample> fill_curve;
 };
+
+// The stages before any grain: the die read, the shoe planned, the grains sized, the run's size
+// checked (pipeline/preflight.hpp) and the walls prepared (from the cache when it holds them).
+struct FillSetup {
+  DieSource source;
+  ShoePlan shoe;
+  GrainSizing grains;
+  FillWalls walls;
+};
+FillSetup set_up_fill(const PipelineScene& scene, const std::filesystem::path& die_mesh,
+                      const std::shared_ptr<dem::Exchange>& ranks = nullptr);
 
 // Throws InputError for bad input and StabilityError when the run stops on a stability check.
 // Split over MPI ranks (every rank calls it with the session's exchange), rank 0 writes the

@@ -12,6 +12,7 @@
 #include "pipeline/pictures.hpp"
 #include "pipeline/run_loop.hpp"
 #include "postprocess/compaction.hpp"
+#include "postprocess/ensemble_stats.hpp"
 
 namespace app {
 
@@ -56,8 +57,34 @@ FemSettings fem_settings(double grain_diameter, double density_voxel, double ele
   return s;
 }
 
-nlohmann::json write_fem_outputs(const std::vector<post::Grain>& grains, const mesh::PreparedDie& die, const mesh::WallField& walls,
-                                 double material_density, double mass_in_cavity_kg, const FemSettings& s, const fs::path& dir) {
+namespace {
+
+// One realisation's fill, or a seed ensemble's: the mean of its realisations' element values on
+// the one mesh (Mesh_3 is deterministic, and each is filled on a copy of it), with their
+// standard errors.
+post::FemFill fill_of_realisations(const mesh::TetMesh& tets, const std::vector<std::vector<post::Grain>>& realisations,
+                                   const post::CavityShape& cavity, double sub_voxel, double material_density) {
+  std::vector<post::FemFill> fills;
+  for (const std::vector<post::Grain>& grains : realisations)
+    fills.push_back(post::fill_elements(tets, grains, cavity, sub_voxel, material_density));
+  if (fills.size() == 1) return std::move(fills.front());
+  std::vector<std::vector<double>> fractions;
+  for (const post::FemFill& f : fills) fractions.push_back(f.element_fraction);
+  post::MeanAndError m = post::mean_and_error(fractions);
+  post::FemFill mean = std::move(fills.front());
+  mean.element_fraction = std::move(m.mean);
+  mean.element_fraction_stderr = std::move(m.error);
+  mean.solid_volume_m3 = 0;
+  for (std::size_t e = 0; e < mean.element_fraction.size(); ++e) mean.solid_volume_m3 += mean.element_fraction[e] * mean.element_volume[e];
+  mean.node_fraction = post::average_to_nodes(mean.mesh, mean.element_fraction, mean.element_volume);
+  return mean;
+}
+
+}  // namespace
+
+nlohmann::json write_fem_outputs(const std::vector<std::vector<post::Grain>>& realisations, const mesh::PreparedDie& die,
+                                 const mesh::WallField& walls, double material_density, double mass_in_cavity_kg,
+                                 const FemSettings& s, const fs::path& dir) {
   diefill::ChildWait wait;
   wait.stop = stop_requested;
   wait.waiting = [&](double seconds) {
@@ -65,11 +92,11 @@ nlohmann::json write_fem_outputs(const std::vector<post::Grain>& grains, const m
                        "the hand-off and keeps the fill; fem.element_size coarsens it)",
                        die.name, s.element_size_m * 1e3, seconds);
   };
-  mesh::TetMesh tets = mesh::tetrahedralise(die.cavity, {s.element_size_m, s.element_size_m / 200, 60}, die.source, wait);
+  const mesh::TetMesh tets = mesh::tetrahedralise(die.cavity, {s.element_size_m, s.element_size_m / 200, 60}, die.source, wait);
   const mesh::TetQuality q = mesh::tet_quality(tets);
   const post::CavityShape cavity{[&](const post::Vec3& p) { return walls.signed_distance(p); }, die.after.bbox.lo,
                                  post::Vec3(die.after.bbox.hi.x(), die.after.bbox.hi.y(), die.table_z)};
-  const post::FemFill fill = post::fill_elements(std::move(tets), grains, cavity, s.sub_voxel_m, material_density);
+  const post::FemFill fill = fill_of_realisations(tets, realisations, cavity, s.sub_voxel_m, material_density);
   const fs::path fem = dir / "fem";
   fs::create_directories(fem);
   const std::size_t nodes = post::write_fem(fill, s.quadratic, fmt::format("diefill fill of {} ({})", die.name, die.source), fem);
@@ -95,6 +122,12 @@ nlohmann::json write_fem_outputs(const std::vector<post::Grain>& grains, const m
       {"mass_error_rel", mass_in_cavity_kg > 0 ? mass / mass_in_cavity_kg - 1 : 0.0},
       {"solid_fraction_min", *lo},
       {"solid_fraction_max", *hi}};
+  if (!fill.element_fraction_stderr.empty()) {
+    std::vector<double> sorted = fill.element_fraction_stderr;
+    std::sort(sorted.begin(), sorted.end());
+    j["solid_fraction_stderr_median"] = sorted[sorted.size() / 2];
+    j["solid_fraction_stderr_max"] = sorted.back();
+  }
   if (s.compaction) {
     try {
       j["compaction"] = compaction_example(fill, fem);

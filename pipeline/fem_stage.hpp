@@ -29,8 +29,10 @@ struct FemSettings {
 FemSettings fem_settings(double grain_diameter, double density_voxel, double element_size);
 
 // Writes `dir`/fem/ and returns the report's `fem` section; `mass_in_cavity_kg` is the density
-// field's (fill.mass_kg), which the elements' mass is measured against (fem.mass_error_rel).
-nlohmann::json write_fem_outputs(const std::vector<post::Grain>& cavity_grains, const mesh::PreparedDie& die,
+// field's (fill.mass_kg), which the elements' mass is measured against (fem.mass_error_rel). Each
+// realisation is one run's grains in the cavity; several (a seed ensemble's) give each element
+// their mean and its standard error, on one mesh.
+nlohmann::json write_fem_outputs(const std::vector<std::vector<post::Grain>>& realisations, const mesh::PreparedDie& die,
                                  const mesh::WallField& walls, double material_density, double mass_in_cavity_kg,
                                  const FemSettings& settings, const std::filesystem::path& dir);
 

@@ -63,10 +63,18 @@ double strike_off_time(const ShoePlan& shoe, double die_far_x) {
   return shoe.t_motion;
 }
 
-void write_fill_curve(const std::vector<FillSample>& curve, double capacity_kg, const std::filesystem::path& csv) {
-  std::string text = "t_s,shoe_x_m,grains_in_cavity,mass_in_cavity_kg,fraction_of_capacity\n";
-  for (const FillSample& p : curve)
-    text += fmt::format("{:.9g},{:.9g},{},{:.9g},{:.6g}\n", p.time, p.shoe_x, p.grains, p.mass, capacity_kg > 0 ? p.mass / capacity_kg : 0.0);
+void write_fill_curve(const std::vector<FillSample>& curve, double capacity_kg, const std::filesystem::path& csv,
+                      const FillBand* band) {
+  const auto share = [&](double mass) { return capacity_kg > 0 ? mass / capacity_kg : 0.0; };
+  std::string text = band ? "t_s,shoe_x_m,grains_in_cavity,grains_in_cavity_stderr,mass_in_cavity_kg,mass_in_cavity_kg_stderr,"
+                            "fraction_of_capacity,fraction_of_capacity_stderr\n"
+                          : "t_s,shoe_x_m,grains_in_cavity,mass_in_cavity_kg,fraction_of_capacity\n";
+  for (std::size_t k = 0; k < curve.size(); ++k) {
+    const FillSample& p = curve[k];
+    text += band ? fmt::format("{:.9g},{:.9g},{:.6g},{:.4g},{:.9g},{:.4g},{:.6g},{:.4g}\n", p.time, p.shoe_x, band->grains[k],
+                               band->grains_stderr[k], p.mass, band->mass_stderr[k], share(p.mass), share(band->mass_stderr[k]))
+                 : fmt::format("{:.9g},{:.9g},{},{:.9g},{:.6g}\n", p.time, p.shoe_x, p.grains, p.mass, share(p.mass));
+  }
   diefill::write_file_atomic(csv, text);
 }
 

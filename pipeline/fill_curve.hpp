@@ -28,8 +28,16 @@ FillSample sample_fill(const dem::State& state, double table_z, double material_
 // strike-off; the shoe's time of motion when it never does (a return stroke does).
 double strike_off_time(const ShoePlan& shoe, double die_far_x);
 
+// A seed ensemble's fill curve: per sample the seeds' means and the standard errors of them.
+struct FillBand {
+  std::vector<double> grains, grains_stderr, mass_stderr;
+};
+
 // `fill_curve.csv`: t_s, shoe_x_m, grains_in_cavity, mass_in_cavity_kg, fraction_of_capacity
-// (the mass over the cavity's volume times the material density).
-void write_fill_curve(const std::vector<FillSample>& curve, double capacity_kg, const std::filesystem::path& csv);
+// (the mass over the cavity's volume times the material density); with a band (an ensemble's
+// mean curve), the mean grains and the standard errors grains_in_cavity_stderr,
+// mass_in_cavity_kg_stderr and fraction_of_capacity_stderr besides.
+void write_fill_curve(const std::vector<FillSample>& curve, double capacity_kg, const std::filesystem::path& csv,
+                      const FillBand* band = nullptr);
 
 }  // namespace app

@@ -12,6 +12,7 @@
 #include "dem/io.hpp"
 #include "dem/step.hpp"
 #include "pipeline/density_stage.hpp"
+#include "pipeline/ensemble.hpp"
 #include "pipeline/fem_stage.hpp"
 #include "mesh/tetmesh.hpp"
 #include "pipeline/fill_curve.hpp"
@@ -24,65 +25,72 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The density field of the cavity's grains (none: a warning and an empty fill).
-nlohmann::json write_density_field(const FillRecord& r, const fs::path& dir) {
-  if (r.census.cavity.empty()) {
-    diefill::log::warn("{}: no grain entered the cavity; no density field", r.walls.die.name);
+DensitySettings density_settings(const PipelineScene& scene, const GrainSizing& grains) {
+  DensitySettings ds;
+  ds.voxel_m = scene.density_voxel > 0 ? scene.density_voxel : 2 * grains.diameter;
+  ds.method = scene.density_method;
+  ds.smoothed_width_m = scene.density_smoothed_width > 0 ? scene.density_smoothed_width : 0.5 * grains.diameter;
+  ds.coarse_graining = grains.alpha;
+  return ds;
+}
+
+double powder_density(const FillWalls& walls) { return walls.spec.materials[std::size_t(walls.powder)].density; }
+
+// The density field of the cavity's grains (none: a warning and an empty fill), of a seed
+// ensemble the mean of its seeds' fields; the report's `fill` figures are then the seeds' means,
+// each with its standard error beside it (pipeline/ensemble.hpp).
+nlohmann::json write_density_field(const FillSetting& c, const Realisations& r, const fs::path& dir) {
+  if (std::any_of(r.cavity.begin(), r.cavity.end(), [](const auto& grains) { return grains.empty(); })) {
+    diefill::log::warn("{}: no grain entered the cavity; no density field", c.walls.die.name);
     return {{"mass_kg", 0.0}, {"fill_ratio", 0.0}, {"voxel_m", 0.0}};
   }
-  DensitySettings ds;
-  ds.voxel_m = r.scene.density_voxel > 0 ? r.scene.density_voxel : 2 * r.grains.diameter;
-  ds.method = r.scene.density_method;
-  ds.smoothed_width_m = r.scene.density_smoothed_width > 0 ? r.scene.density_smoothed_width : 0.5 * r.grains.diameter;
-  ds.coarse_graining = r.grains.alpha;
-  const double density = r.walls.spec.materials[std::size_t(r.walls.powder)].density;
-  const DensityResult field = compute_density(r.census.cavity, r.walls.die, *r.walls.die_field, density, ds, r.walls.die.name);
-  write_density(field, dir);
-  nlohmann::json fill = statistics_json(field.stats);
+  const DensitySettings ds = density_settings(c.scene, c.grains);
+  std::vector<DensityResult> fields;
+  std::vector<nlohmann::json> figures;
+  for (const std::vector<post::Grain>& grains : r.cavity) {
+    fields.push_back(compute_density(grains, c.walls.die, *c.walls.die_field, powder_density(c.walls), ds, c.walls.die.name));
+    figures.push_back(statistics_json(fields.back().stats));
+  }
+  write_density(fields.size() == 1 ? fields.front() : mean_density(fields), dir);
+  nlohmann::json fill = figures.size() == 1 ? figures.front() : mean_with_stderr(figures);
   fill["voxel_m"] = ds.voxel_m;
   fill["smoothed_width_m"] = ds.smoothed_width_m;
   return fill;
 }
 
 // The FEM hand-off (fem/), on elements as large as the density voxels unless the scene says.
-nlohmann::json write_fem_section(const FillRecord& r, const nlohmann::json& fill, const fs::path& dir) {
-  if (r.census.cavity.empty() || r.scene.fem_elements == "none") return nullptr;
-  FemSettings settings = fem_settings(r.grains.diameter, fill.at("voxel_m").get<double>(), r.scene.fem_element_size);
-  settings.quadratic = r.scene.fem_elements == "quadratic";
-  settings.compaction = r.scene.fem_compaction == "calculix";
-  const double density = r.walls.spec.materials[std::size_t(r.walls.powder)].density;
+nlohmann::json write_fem_section(const FillSetting& c, const Realisations& r, const nlohmann::json& fill, const fs::path& dir) {
+  if (fill.at("voxel_m").get<double>() <= 0 || c.scene.fem_elements == "none") return nullptr;
+  FemSettings settings = fem_settings(c.grains.diameter, fill.at("voxel_m").get<double>(), c.scene.fem_element_size);
+  settings.quadratic = c.scene.fem_elements == "quadratic";
+  settings.compaction = c.scene.fem_compaction == "calculix";
   try {
-    return write_fem_outputs(r.census.cavity, r.walls.die, *r.walls.die_field, density, fill.at("mass_kg"), settings, dir);
+    return write_fem_outputs(r.cavity, c.walls.die, *c.walls.die_field, powder_density(c.walls), fill.at("mass_kg"), settings, dir);
   } catch (const mesh::TetMeshingStopped&) {
     diefill::log::warn("{}: the FEM hand-off was stopped while its tetrahedra were meshed: no fem/; the fill's outputs are "
-                       "written", r.walls.die.name);
+                       "written", c.walls.die.name);
     return nullptr;
   }
 }
 
-// The fill curve (CSV and chart; it ends at the field's mass, fill.mass_kg) and what the report
-// says of it: the cavity's capacity (its volume full of solid material) and the strike-off.
-nlohmann::json write_fill_curve_outputs(const FillRecord& r, const fs::path& dir) {
-  const double density = r.walls.spec.materials[std::size_t(r.walls.powder)].density;
-  const double capacity = r.walls.die.after.volume_m3 * density;
-  const double strike_off = strike_off_time(r.shoe, mesh::bounding_box(r.walls.die.cavity).hi.x());
-  write_fill_curve(r.fill.curve, capacity, dir / "fill_curve.csv");
+// The fill curve (CSV and chart; it ends at the field's mass, fill.mass_kg; an ensemble's with
+// its band) and what the report says of it: the cavity's capacity (its volume full of solid
+// material) and the strike-off.
+nlohmann::json write_fill_curve_outputs(const FillSetting& c, const Realisations& r, const fs::path& dir) {
+  const double capacity = c.walls.die.after.volume_m3 * powder_density(c.walls);
+  const double strike_off = strike_off_time(c.shoe, mesh::bounding_box(c.walls.die.cavity).hi.x());
+  if (r.curves.size() == 1) {
+    write_fill_curve(r.curves.front(), capacity, dir / "fill_curve.csv");
+  } else {
+    const auto [curve, band] = mean_curve(r.curves);
+    write_fill_curve(curve, capacity, dir / "fill_curve.csv", &band);
+  }
   draw_pictures({"fill_curve", (dir / "fill_curve.csv").string(), fmt::format("{:.9g}", strike_off)});
   return {{"cavity_capacity_kg", capacity},
           {"strike_off_s", strike_off},
           {"curve", "fill_curve.csv"}};
 }
 
-// Of every key that shapes the result (not where it is written, nor how fast) and the materials,
-// but the seed (run.seed beside it): runs with equal hashes are the same scene, and with equal
-// seeds too the same run (`diefill compare` tells seeds of one scene from different scenes).
-std::string scene_hash(const PipelineScene& s) {
-  PipelineScene unseeded = s;
-  unseeded.seed = 0;
-  std::string text;
-  for (const Shapes what : {Shapes::die, Shapes::settling, Shapes::run}) text += shaping_values(pipeline_keys(), what, unseeded);
-  return diefill::sha256_hex(text + describe_materials(s.spec));
-}
 
 // The run's own checks that do not stop it (those that do, the monitor's overlap and energy
 // limits, stop the run with status 3 and write no report): every grain the insertion made is
@@ -172,11 +180,28 @@ nlohmann::json report_json(const FillRecord& r, const nlohmann::json& fill, cons
 
 }  // namespace
 
+// Of every key that shapes the result (not where it is written, nor how fast) and the materials,
+// but the seed (run.seed beside it): runs with equal hashes are the same scene, and with equal
+// seeds too the same run (`diefill compare` tells seeds of one scene from different scenes).
+std::string scene_hash(const PipelineScene& s) {
+  PipelineScene unseeded = s;
+  unseeded.seed = 0;
+  std::string text;
+  for (const Shapes what : {Shapes::die, Shapes::settling, Shapes::run}) text += shaping_values(pipeline_keys(), what, unseeded);
+  return diefill::sha256_hex(text + describe_materials(s.spec));
+}
+
+FillProducts write_fill_products(const FillSetting& setting, const Realisations& r, const fs::path& dir) {
+  FillProducts p;
+  p.fill = write_density_field(setting, r, dir);
+  p.fill.update(write_fill_curve_outputs(setting, r, dir));
+  p.fem = write_fem_section(setting, r, p.fill, dir);
+  return p;
+}
+
 nlohmann::json write_fill_outputs(const FillRecord& r, const fs::path& dir) {
   diefill::StagingFolder out(dir);
-  nlohmann::json fill = write_density_field(r, out.path());
-  fill.update(write_fill_curve_outputs(r, out.path()));
-  const nlohmann::json fem = write_fem_section(r, fill, out.path());
+  const auto [fill, fem] = write_fill_products({r.scene, r.walls, r.grains, r.shoe}, {{r.census.cavity}, {r.fill.curve}}, out.path());
   dem::write_particles_csv(r.fill.state, out / "particles.csv");
   dem::write_vtu(r.fill.state, out / "final.vtu");
   diefill::write_file_atomic(out / "scene.toml", describe(r.scene));

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pipeline/census.hpp"
+#include "pipeline/fill_curve.hpp"
 #include "pipeline/shoe_fill.hpp"
 #include "pipeline/shoe_pass.hpp"
 
@@ -27,5 +28,29 @@ struct FillRecord {
 
 // Writes every output into `dir` (staged: a failure keeps the earlier outputs); returns the report.
 nlohmann::json write_fill_outputs(const FillRecord& record, const std::filesystem::path& dir);
+
+// What one run's field, fill curve and FEM hand-off are made of, or a seed ensemble's (one entry
+// per seed): the grains in the cavity and the fill curve.
+struct Realisations {
+  std::vector<std::vector<post::Grain>> cavity;
+  std::vector<std::vector<FillSample>> curves;
+};
+// What the realisations share.
+struct FillSetting {
+  const PipelineScene& scene;
+  const FillWalls& walls;
+  const GrainSizing& grains;
+  const ShoePlan& shoe;
+};
+struct FillProducts {
+  nlohmann::json fill, fem;  // the report's sections
+};
+// The density field and its pictures, the fill curve and the FEM hand-off, into `dir`: one run's,
+// or an ensemble's means with their standard errors (pipeline/ensemble.hpp).
+FillProducts write_fill_products(const FillSetting& setting, const Realisations& realisations, const std::filesystem::path& dir);
+
+// The report's hash of the scene's shaping keys and materials, the seed left out: seeds of one
+// scene hash alike (`diefill compare`, the ensemble's check that its runs belong together).
+std::string scene_hash(const PipelineScene& scene);
 
 }  // namespace app

@@ -56,6 +56,8 @@ void add_grids(const DensityField& f, const std::string& prefix, openvdb::GridPt
   grids.push_back(grid_of(f, prefix + "cavity_fraction", [&](std::size_t n) { return f.cavity[n]; }));
   if (prefix.empty())  // the smoothed field's kernel spans the wall: it merges (almost) nothing
     grids.push_back(grid_of(f, "merged", [&](std::size_t n) { return double(f.corrected.merged[n]); }));
+  if (!f.solid_fraction_stderr.empty())
+    grids.push_back(grid_of(f, prefix + "solid_fraction_stderr", [&](std::size_t n) { return f.solid_fraction_stderr[n]; }));
   for (std::size_t g = first; g < grids.size(); ++g) {
     for (const auto& [key, value] : f.metadata) grids[g]->insertMeta(key, openvdb::StringMetadata(value));
     grids[g]->insertMeta("units", openvdb::StringMetadata("m"));
@@ -156,6 +158,7 @@ void write_vti(const DensityField& f, const std::filesystem::path& path) {
   array("density", [&](std::size_t n) { return phi[n] * f.material_density; });
   array("cavity_fraction", [&](std::size_t n) { return f.cavity[n]; });
   array("merged", [&](std::size_t n) { return double(f.corrected.merged[n]); });
+  if (!f.solid_fraction_stderr.empty()) array("solid_fraction_stderr", [&](std::size_t n) { return f.solid_fraction_stderr[n]; });
   out += "</CellData>\n</Piece>\n</ImageData>\n</VTKFile>\n";
   diefill::write_file_atomic(path, out);
 }
@@ -195,32 +198,40 @@ nlohmann::json section(const DensityField& f, bool along) {
 
 nlohmann::json sections(const DensityField& f) { return {{"along", section(f, true)}, {"across", section(f, false)}}; }
 
-// Each column's cavity-weighted mean of the wall-corrected field (the fill an x-ray would see,
-// with the wall's slivers carrying their merged values, as in the sections), and whether most of
-// its cavity holds merged voxels.
+// The top view: each column's mean (the fill an x-ray would see, with the wall's slivers
+// carrying their merged values, as in the sections), whether most of its cavity holds merged
+// voxels, and, for an ensemble, its standard error.
 void top_view(const DensityField& f, nlohmann::json& j) {
   const VoxelGrid& g = f.grid;
-  nlohmann::json top = nlohmann::json::array(), merged = nlohmann::json::array(), cavity = nlohmann::json::array();
+  const std::vector<double> means = column_means(f);
+  nlohmann::json top = nlohmann::json::array(), merged = nlohmann::json::array(), cavity = nlohmann::json::array(),
+                 error = nlohmann::json::array();
   for (int i = 0; i < g.nx; ++i) {
-    nlohmann::json row = nlohmann::json::array(), flags = nlohmann::json::array(), column_cavity = nlohmann::json::array();
+    nlohmann::json row = nlohmann::json::array(), flags = nlohmann::json::array(), column_cavity = nlohmann::json::array(),
+                   column_error = nlohmann::json::array();
     for (int jj = 0; jj < g.ny; ++jj) {
-      double sum = 0, weight = 0, merged_weight = 0;
+      double weight = 0, merged_weight = 0;
       for (int k = 0; k < g.nz; ++k) {
         const std::size_t n = g.index(i, jj, k);
-        const double phi = f.corrected.solid_fraction[n];
-        if (f.cavity[n] <= 0 || !std::isfinite(phi)) continue;
-        sum += f.cavity[n] * phi, weight += f.cavity[n];
+        if (f.cavity[n] <= 0 || !std::isfinite(f.corrected.solid_fraction[n])) continue;
+        weight += f.cavity[n];
         if (f.corrected.merged[n]) merged_weight += f.cavity[n];
       }
-      row.push_back(weight > 0 ? sum / weight : -1.0);
+      const std::size_t column = std::size_t(i) * std::size_t(g.ny) + std::size_t(jj);
+      row.push_back(means[column]);
       flags.push_back(int(weight > 0 && merged_weight > 0.5 * weight));
       column_cavity.push_back(weight);
+      if (!f.column_stderr.empty()) column_error.push_back(means[column] >= 0 ? f.column_stderr[column] : -1.0);
     }
-    top.push_back(row), merged.push_back(flags), cavity.push_back(column_cavity);
+    top.push_back(row), merged.push_back(flags), cavity.push_back(column_cavity), error.push_back(column_error);
   }
   j["top_view"] = top;
   j["top_merged"] = merged;
   j["top_cavity_voxels"] = cavity;
+  if (!f.column_stderr.empty()) {
+    j["top_stderr"] = error;
+    j["stderr_marked_fraction"] = stderr_marked_fraction;
+  }
 }
 
 // The colour scale from the cavity's own values: the 1st to the 99th cavity-weighted percentile
@@ -249,6 +260,23 @@ nlohmann::json grid_json(const VoxelGrid& g) {
 }
 
 }  // namespace
+
+std::vector<double> column_means(const DensityField& f) {
+  const VoxelGrid& g = f.grid;
+  std::vector<double> out(std::size_t(g.nx) * std::size_t(g.ny), -1.0);
+  for (int i = 0; i < g.nx; ++i)
+    for (int j = 0; j < g.ny; ++j) {
+      double sum = 0, weight = 0;
+      for (int k = 0; k < g.nz; ++k) {
+        const std::size_t n = g.index(i, j, k);
+        const double phi = f.corrected.solid_fraction[n];
+        if (f.cavity[n] <= 0 || !std::isfinite(phi)) continue;
+        sum += f.cavity[n] * phi, weight += f.cavity[n];
+      }
+      if (weight > 0) out[std::size_t(i) * std::size_t(g.ny) + std::size_t(j)] = sum / weight;
+    }
+  return out;
+}
 
 namespace {
 nlohmann::json profiles_json(const FieldStatistics& st) {

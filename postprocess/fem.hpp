@@ -24,6 +24,7 @@ struct FemFill {
   double binned_solid_m3 = 0;           // the grains' volume below the table, exactly binned on the sub-voxels
   double outside_mesh_m3 = 0;           // of that, in sub-voxels no element reaches
   double sub_voxel_m = 0;               // the binning voxel the element values are integrated from
+  std::vector<double> element_fraction_stderr;  // a seed ensemble's: of its elements' means (empty: one run)
 };
 
 // The cavity the mesh fills: the signed distance to its walls (positive inside) and its box,
@@ -77,7 +78,8 @@ std::vector<double> average_to_nodes(const mesh::TetMesh& mesh, const std::vecto
 //                      and density as solution-dependent state per element (Abaqus' syntax);
 //   fill_calculix.inp  the same state in CalculiX' syntax (per integration point) and the
 //                      nodes' solid fraction as their initial temperature;
-//   fill.vtu           the elements with both as cell and point data (ParaView, meshio).
+//   fill.vtu           the elements with both as cell and point data (ParaView, meshio), and an
+//                      ensemble's solid_fraction_stderr per element.
 // Returns the number of nodes written (with the middle nodes of quadratic elements).
 std::size_t write_fem(const FemFill& fill, bool quadratic, const std::string& heading, const std::filesystem::path& dir);
 

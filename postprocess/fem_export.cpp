@@ -139,6 +139,8 @@ std::string vtu(const FemFill& f, const Elements& el) {
   array("solid_fraction", cells, [&](std::size_t e) { return f.element_fraction[e]; });
   array("density_kg_m3", cells, [&](std::size_t e) { return f.element_fraction[e] * f.material_density; });
   array("volume_m3", cells, [&](std::size_t e) { return f.element_volume[e]; });
+  if (!f.element_fraction_stderr.empty())
+    array("solid_fraction_stderr", cells, [&](std::size_t e) { return f.element_fraction_stderr[e]; });
   out += "</CellData>\n<PointData Scalars=\"solid_fraction\">\n";
   array("solid_fraction", points, [&](std::size_t n) { return (*el.node_fraction)[n]; });
   array("density_kg_m3", points, [&](std::size_t n) { return (*el.node_fraction)[n] * f.material_density; });

@@ -25,7 +25,17 @@ struct DensityField {
   double min_cavity = 0.25;            // the wall correction's threshold (and the profiles')
   double material_density = 0;         // [kg/m³]
   std::map<std::string, std::string> metadata;  // written into density.vdb
+  // A seed ensemble's mean field carries the standard error of its seeds' mean (empty for one
+  // run): per voxel of the solid fraction, and per column (index i × ny + j) of the columns' means.
+  std::vector<double> solid_fraction_stderr, column_stderr;
 };
+
+// Each column's (i, j) cavity-weighted mean of the wall-corrected field, at i × ny + j; -1 where
+// the column holds no cavity (the top view's values).
+std::vector<double> column_means(const DensityField& field);
+
+// An ensemble's pictures mark the columns whose standard error exceeds this fraction of the fill.
+inline constexpr double stderr_marked_fraction = 0.02;
 
 struct Profile {
   std::string axis;                    // "z", "r" or "x"
@@ -68,7 +78,8 @@ struct Outlines {
 // density.vdb: FloatGrids solid_fraction, density [kg/m³], cavity_fraction and merged (1 where
 // the wall correction pooled the voxel with a neighbour) in world metres, with the field's
 // metadata; with a smoothed field, its grids beside them as smoothed_solid_fraction,
-// smoothed_density and smoothed_cavity_fraction on their own transform. Written atomically.
+// smoothed_density and smoothed_cavity_fraction on their own transform; an ensemble's also
+// solid_fraction_stderr (and smoothed_solid_fraction_stderr). Written atomically.
 void write_vdb(const DensityField& field, const DensityField* smoothed, const std::filesystem::path& path);
 // A field's grids as VTK image cell data, for ParaView.
 void write_vti(const DensityField& field, const std::filesystem::path& path);

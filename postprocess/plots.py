@@ -79,6 +79,28 @@ def _section(ax, section, outline, lo, hi, xlabel, title):
     return im
 
 
+def _stderr_panel(ax, data, top, extent_xy, outline) -> None:
+    """An ensemble's standard error of each column's mean, relative to the fill, with the columns
+    over the stated fraction marked."""
+    error = np.array(data["top_stderr"], dtype=float)
+    fraction = data["stderr_marked_fraction"]
+    relative = np.where(top > 0, error / np.maximum(data["mean"], 1e-12), -1.0)
+    im = ax.imshow(np.ma.masked_less(relative, 0).T * 100, origin="lower", extent=extent_xy, cmap="magma",
+                   interpolation="nearest")
+    _outline(ax, outline["top"])
+    _crop_to(ax, top, extent_xy, top.shape)
+    over = np.argwhere(relative > fraction)
+    if over.size:
+        u0, u1, v0, v1 = extent_xy
+        du, dv = (u1 - u0) / relative.shape[0], (v1 - v0) / relative.shape[1]
+        ax.plot(u0 + (over[:, 0] + 0.5) * du, v0 + (over[:, 1] + 0.5) * dv, "+", color="cyan", markersize=5)
+    ax.set_xlabel("x [mm]")
+    ax.set_ylabel("y [mm]")
+    ax.set_title(f"Standard error of the column means over the seeds\n+: above {fraction * 100:.0f} % of the fill",
+                 fontsize="small")
+    plt.colorbar(im, ax=ax, label="standard error / mean fill [%]")
+
+
 def density(out_dir: Path) -> None:
     data = json.loads((out_dir / "plot_data.json").read_text())
     h_mm = data["voxel_m"] * 1e3
@@ -89,7 +111,9 @@ def density(out_dir: Path) -> None:
     outline = data["outline"]
 
     top = np.array(data["top_view"], dtype=float)
-    fig, ax = plt.subplots(figsize=(6.4, 5.4))
+    ensemble = "top_stderr" in data
+    fig, axes = plt.subplots(1, 2 if ensemble else 1, figsize=(12.4 if ensemble else 6.4, 5.4), squeeze=False)
+    ax = axes[0][0]
     im = ax.imshow(np.ma.masked_less(top, 0).T, origin="lower", extent=extent_xy, cmap="viridis", vmin=lo, vmax=hi,
                    interpolation="nearest")
     _outline(ax, outline["top"])
@@ -97,8 +121,11 @@ def density(out_dir: Path) -> None:
     _merged(ax, data["top_merged"], extent_xy)
     ax.set_xlabel("x [mm]    shoe travel \u2192 (+x)")
     ax.set_ylabel("y [mm]")
-    ax.set_title(f"Fill density, column average of the wall-corrected field\n{MERGED}", fontsize="small")
+    what = "the seeds' mean, " if ensemble else ""
+    ax.set_title(f"Fill density, {what}column average of the wall-corrected field\n{MERGED}", fontsize="small")
     fig.colorbar(im, ax=ax, label="solid fraction [-]", extend="both")
+    if ensemble:
+        _stderr_panel(axes[0][1], data, top, extent_xy, outline)
     fig.tight_layout()
     fig.savefig(out_dir / "top_view.png", dpi=120)
     plt.close(fig)
@@ -213,6 +240,9 @@ def fill_curve(csv: Path, strike_off_s: float) -> None:
     mass_g = np.atleast_1d(rows["mass_in_cavity_kg"]) * 1e3
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4))
     left.plot(t, mass_g, color="tab:blue")
+    if "mass_in_cavity_kg_stderr" in rows.dtype.names:  # a seed ensemble: its mean with a band of 2 standard errors
+        band_g = 2 * np.atleast_1d(rows["mass_in_cavity_kg_stderr"]) * 1e3
+        left.fill_between(t, mass_g - band_g, mass_g + band_g, color="tab:blue", alpha=0.25, label="\u00b12 standard errors")
     left.axvline(strike_off_s, color="k", linestyle="--", label=f"strike-off, t = {strike_off_s:.3f} s")
     left.set_xlabel("time [s]")
     left.set_ylabel("mass in the cavity [g]")
