@@ -12,6 +12,7 @@
 #include "pipeline/compare.hpp"
 #include "pipeline/die_fill.hpp"
 #include "pipeline/ensemble.hpp"
+#include "pipeline/ladder.hpp"
 #include "pipeline/preflight.hpp"
 #include "pipeline/sweep.hpp"
 #include "pipeline/run_loop.hpp"
@@ -96,18 +97,39 @@ PipelineScene command_scene(const RunCommand& c, const std::vector<std::string>&
   return scene;
 }
 
-int run_seed_ensemble(const RunCommand& c, const std::shared_ptr<dem::Exchange>& ranks) {
+// Ensembles and ladders run one die afresh: no folder, sweep or resume.
+void refuse_beside_many_runs(const RunCommand& c, const char* option) {
   if (fs::is_directory(c.target) || c.sweep || c.resume)
-    throw diefill::InputError("--seeds", c.sweep ? "--sweep" : c.resume ? "--resume" : c.target.string(),
-                              "a seed ensemble runs one die, afresh", "Give one die mesh or scene, without --sweep or --resume");
-  const DieRun run = run_ensemble([&](const std::vector<std::string>& more) { return command_scene(c, more); }, c.seeds, ranks);
+    throw diefill::InputError(option, c.sweep ? "--sweep" : c.resume ? "--resume" : c.target.string(), "runs one die, afresh",
+                              "Give one die mesh or scene, without --sweep or --resume");
+}
+
+int finish_many_runs(const DieRun& run, const std::shared_ptr<dem::Exchange>& ranks) {
   const bool root = !ranks || ranks->rank() == 0;
   if (run.interrupted) {
-    if (root) fmt::print(stderr, "interrupted; a seed ensemble does not resume: rerun the command\n");
+    if (root) fmt::print(stderr, "interrupted; seed ensembles and ladders do not resume: rerun the command\n");
     return diefill::exit_interrupted;
   }
-  if (root) fmt::print("{}: {} seeds, report {}\n", run.die, c.seeds, (run.dir / "report.json").string());
+  if (root) fmt::print("{}: report {}\n", run.die, (run.dir / "report.json").string());
   return 0;
+}
+
+int run_seed_ensemble(const RunCommand& c, const std::shared_ptr<dem::Exchange>& ranks) {
+  refuse_beside_many_runs(c, "--seeds");
+  return finish_many_runs(run_ensemble([&](const std::vector<std::string>& more) { return command_scene(c, more); }, *c.seeds, ranks),
+                          ranks);
+}
+
+int run_grain_ladder(const RunCommand& c, const std::shared_ptr<dem::Exchange>& ranks) {
+  refuse_beside_many_runs(c, "--ladder");
+  Ladder ladder = parse_ladder(*c.ladder);
+  ladder.extrapolate_to = c.extrapolate_to;
+  if (c.seeds) ladder.seeds = *c.seeds;
+  if (ladder.seeds < 2)
+    throw diefill::InputError("--seeds", std::to_string(ladder.seeds), "a ladder's levels need two seeds or more for their errors",
+                              "Give --seeds 2 or more");
+  return finish_many_runs(run_ladder([&](const std::vector<std::string>& more) { return command_scene(c, more); }, ladder, ranks),
+                          ranks);
 }
 
 }  // namespace
@@ -141,7 +163,9 @@ int run_pipeline(const RunCommand& c) {
   // Under mpirun every rank runs this; rank 0 reports (pipeline/die_fill.hpp).
   const std::shared_ptr<dem::Exchange> ranks = mpi_exchange();
   const bool root = !ranks || ranks->rank() == 0;
-  if (c.seeds != 1) return run_seed_ensemble(c, ranks);
+  if (c.ladder) return run_grain_ladder(c, ranks);
+  if (c.extrapolate_to) throw diefill::InputError("--extrapolate-to", "", "extrapolates a ladder", "Give --ladder A1,A2,A3 with it");
+  if (c.seeds && *c.seeds != 1) return run_seed_ensemble(c, ranks);
   if (c.sweep) {
     if (fs::is_directory(c.target))
       throw diefill::InputError(c.target.string(), "--sweep", "sweeps one die, not a folder", "Give a die mesh or a scene");

@@ -40,7 +40,9 @@ struct RunCommand {
   std::optional<std::string> units;  // die.units
   bool resume = false;
   bool force = false;  // a size over the limit runs (pipeline/preflight.hpp)
-  int seeds = 1;       // > 1: a seed ensemble (pipeline/ensemble.hpp)
+  std::optional<int> seeds;              // > 1: a seed ensemble (pipeline/ensemble.hpp); per level of a ladder
+  std::optional<std::string> ladder;     // A1,A2,A3: a grain-size ladder (pipeline/ladder.hpp)
+  std::optional<double> extrapolate_to;  // the ladder's answer at this α (default 1: the real powder)
   std::optional<std::string> sweep;  // KEY=V1,V2,...: one run per value (pipeline/sweep.hpp)
 };
 int run_pipeline(const RunCommand& command);

@@ -52,7 +52,11 @@ void add_run(CLI::App& root, app::RunCommand& c, std::function<int()>& action) {
   cmd->add_flag("--force", c.force, "Run a scene whose size is over the limit (10³ times the default ring run's work)");
   cmd->add_option("--seeds", c.seeds,
                   "Run N seeds (from --seed or simulation.seed on), each into OUT/simulation.seed=K/, and their mean with "
-                  "its standard error into OUT/<die name>/");
+                  "its standard error into OUT/<die name>/ (with --ladder: seeds per level, default 2)");
+  cmd->add_option("--ladder", c.ladder,
+                  "Run the scene at three or more coarse-graining levels (A1,A2,A3), each a seed ensemble, and extrapolate "
+                  "the fill to the powder's real size");
+  cmd->add_option("--extrapolate-to", c.extrapolate_to, "With --ladder: the coarse graining to extrapolate to (default 1)");
   cmd->add_option("--sweep", c.sweep,
                   "Run once per value of a scene key, each into OUT/KEY=VALUE/, with a summary table and chart: "
                   "--sweep motion.speed=0.05,0.1,0.2");

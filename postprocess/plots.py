@@ -10,6 +10,7 @@
                                   cavity against time and against the shoe's position
     plots.py compare DIR  ->  DIR/compare.png (from DIR/compare_plot.json): two runs' difference
     plots.py sweep DIR/sweep.json  ->  DIR/sweep.png: fill ratio against the swept key
+    plots.py ladder DIR/ladder.json  ->  DIR/extrapolation.png: a grain-size ladder's levels and fit
 
 Each picture has axes with units and, where colour carries a value, a colour bar.
 """
@@ -331,9 +332,38 @@ def compaction(document: Path) -> None:
     plt.close(fig)
 
 
+def ladder(document: Path) -> None:
+    """A grain-size ladder: each level's fill ratio (2 standard errors) against the grain diameter,
+    the fitted line with its band, and the extrapolated answer."""
+    data = json.loads(document.read_text())
+    d = np.array([level["grain_diameter_m"] for level in data["levels"]]) * 1e3
+    y = np.array([level["fill_ratio"] for level in data["levels"]])
+    se = np.array([level["fill_ratio_stderr"] for level in data["levels"]])
+    target = data["to_grain_diameter_m"] * 1e3
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    ax.errorbar(d, y, yerr=2 * se, fmt="o", color="tab:blue", capsize=3, label="levels (\u00b12 standard errors)")
+    line = np.linspace(min(target, d.min()), d.max(), 50)
+    slope = data["slope_per_m"] * 1e-3
+    at_target = data["fill_ratio"]
+    ax.plot(line, at_target + slope * (line - target), color="tab:blue", linewidth=1)
+    ax.errorbar([target], [at_target], yerr=[2 * data["fill_ratio_stderr"]], fmt="s", color="tab:red", capsize=3,
+                label=f"extrapolated to \u03b1 = {data['to_coarse_graining']:.3g}: {at_target:.4f} \u00b1 {data['fill_ratio_stderr']:.4f}")
+    ax.set_xlabel("grain diameter [mm]")
+    ax.set_ylabel("fill ratio [-]")
+    title = "Fill ratio against the grain size, affine fit"
+    if data.get("refused"):
+        title += "\nrefused: the levels lie off a line beyond their noise"
+    ax.set_title(title, fontsize="medium")
+    ax.legend(fontsize="small")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(document.parent / "extrapolation.png", dpi=120)
+    plt.close(fig)
+
+
 if __name__ == "__main__":
     if sys.argv[1] == "fill_curve":
         fill_curve(Path(sys.argv[2]), float(sys.argv[3]))
     else:
         {"density": density, "clump": clump, "study": study, "compare": compare, "sweep": sweep,
-         "compaction": compaction}[sys.argv[1]](Path(sys.argv[2]))
+         "compaction": compaction, "ladder": ladder}[sys.argv[1]](Path(sys.argv[2]))

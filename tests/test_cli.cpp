@@ -142,6 +142,22 @@ TEST(CliScene, RefusesWhatRunWouldBeforeAnyWork) {
   EXPECT_NE(plain.output.find("The run on ring: 16042 grains"), std::string::npos) << plain.output;
 }
 
+// A grain-size ladder the ring's 5 mm annulus cannot take (2.2 to 4.4 grains across) is refused
+// before any run, naming the part and the α it needs; so are ladders that are no ladders.
+TEST(CliLadder, RefusesWhatItCannotExtrapolateBeforeAnyRun) {
+  const std::string ring = (test::source_dir() / "dies" / "ring.stl").string();
+  test::TempDir dir;
+  const std::string out = " --out " + (dir / "out").string();
+  expect_bad_input("run " + ring + " --ladder 22.6,16,11.3 --extrapolate-to 8" + out, "--ladder", "5 mm wide");
+  expect_bad_input("run " + ring + " --ladder 22.6,16,11.3" + out, "--ladder", "α of 10 or less");
+  EXPECT_FALSE(fs::exists(dir / "out" / "powder.coarse_graining=22.6")) << "no level ran";
+  expect_bad_input("run " + ring + " --ladder 16,8" + out, "--ladder", "three distinct levels");
+  expect_bad_input("run " + ring + " --ladder 16,8,0.5" + out, "--ladder", "[1, 200]");
+  expect_bad_input("run " + ring + " --extrapolate-to 8" + out, "--extrapolate-to", "--ladder");
+  expect_bad_input("run " + ring + " --ladder 16,11.3,8 --seeds 1" + out, "--seeds", "two seeds");
+  expect_bad_input("run " + ring + " --seeds 2 --resume" + out, "--seeds", "afresh");
+}
+
 TEST(CliSimulate, WritesTheFilesOfTheInterface) {
   test::TempDir dir;
   write_scene(dir);

@@ -1,13 +1,19 @@
-// Seed ensembles (pipeline/ensemble.hpp): the standard error of the mean against synthetic
-// seeds of known variance, the report's means with their errors beside them, and the fill
-// curve's band, each against what it must be by construction of the synthetic data.
+// Seed ensembles (pipeline/ensemble.hpp) and grain-size ladders (pipeline/extrapolate.hpp): the
+// standard error of the mean against synthetic seeds of known variance, the report's means with
+// their errors beside them, the fill curve's band, the affine fit against known laws and Monte
+// Carlo, χ²'s quantiles against tables, and the cavity's feature widths against its geometry.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
+#include "mesh/feature_width.hpp"
+#include "mesh/shapes.hpp"
 #include "pipeline/ensemble.hpp"
+#include "pipeline/extrapolate.hpp"
 #include "postprocess/ensemble_stats.hpp"
+
+using Vec3 = Eigen::Vector3d;
 
 namespace {
 
@@ -86,4 +92,98 @@ TEST(EnsembleCurve, BandIsHalfTheTwoSeedsDifference) {
     EXPECT_NEAR(band.grains[n], 11.0 * double(n), 1e-12);
     EXPECT_NEAR(band.grains_stderr[n], 1.0 * double(n), 1e-12);
   }
+}
+
+namespace {
+
+std::vector<app::LevelValue> affine_levels(double intercept, double slope, double curvature, const std::vector<double>& se,
+                                           std::mt19937_64* random) {
+  const std::vector<double> diameters = {2.26e-3, 1.6e-3, 1.13e-3};
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::vector<app::LevelValue> out;
+  for (std::size_t k = 0; k < diameters.size(); ++k) {
+    const double d = diameters[k];
+    out.push_back({d, intercept + slope * d + curvature * d * d + (random ? se[k] * normal(*random) : 0.0), se[k]});
+  }
+  return out;
+}
+
+}  // namespace
+
+// A law the levels follow exactly is recovered to rounding, with χ² = 0.
+TEST(Extrapolation, RecoversAnExactAffineLaw) {
+  const app::AffineFit fit = app::fit_affine(affine_levels(0.60, -30, 0, {0.001, 0.002, 0.003}, nullptr));
+  EXPECT_NEAR(fit.intercept, 0.60, 1e-12);
+  EXPECT_NEAR(fit.slope, -30, 1e-9);
+  EXPECT_NEAR(fit.chi2, 0, 1e-18);
+  EXPECT_EQ(fit.dof, 1);
+}
+
+// 4000 ladders with Gaussian noise of known standard errors: the estimates at d* = 0.1 mm scatter
+// as the fit's own standard error says (before the Birge factor), within 5 %; and an affine law is
+// refused as curved about as often as χ²'s 99 % quantile allows (1 %, at most 2.5 % here), while
+// a law with a real curvature (50 000 /m² × d², whose noise-free levels lie off their best line at
+// χ² = 24.6: a non-central χ² that passes 6.63 99 % of the time) is refused 95 times in 100 or more.
+TEST(Extrapolation, StandardErrorIsTheEstimatesSpreadAndOnlyCurvatureIsRefused) {
+  std::mt19937_64 random(45);
+  const std::vector<double> se = {0.004, 0.0025, 0.0015};
+  const double target = 0.1e-3, truth = 0.60 - 30 * target;
+  double sum = 0, squares = 0, claimed = 0;
+  int refused = 0;
+  const int ladders = 4000;
+  for (int n = 0; n < ladders; ++n) {
+    const app::AffineFit fit = app::fit_affine(affine_levels(0.60, -30, 0, se, &random));
+    const double e = fit.at(target) - truth;
+    sum += e, squares += e * e;
+    claimed += fit.stderr_at(target) / std::sqrt(fit.birge) / ladders;
+    refused += !app::refuse_curved(fit).empty();
+  }
+  const double spread = std::sqrt(squares / ladders - (sum / ladders) * (sum / ladders));
+  EXPECT_NEAR(spread / claimed, 1.0, 0.05);
+  EXPECT_LE(refused, int(0.025 * ladders));
+  EXPECT_NEAR(app::fit_affine(affine_levels(0.60, -30, 5e4, se, nullptr)).chi2, 24.58, 0.01);
+  int curved = 0;
+  for (int n = 0; n < 100; ++n) curved += !app::refuse_curved(app::fit_affine(affine_levels(0.60, -30, 5e4, se, &random))).empty();
+  EXPECT_GE(curved, 95);
+}
+
+// χ²'s 99 % quantiles against the published table (Abramowitz and Stegun 26.4), the Wilson-Hilferty
+// approximation beyond ten degrees of freedom within 0.5 %.
+TEST(Extrapolation, ChiSquareQuantilesMatchTheTables) {
+  EXPECT_DOUBLE_EQ(app::chi2_quantile_99(1), 6.635);
+  EXPECT_DOUBLE_EQ(app::chi2_quantile_99(3), 11.345);
+  EXPECT_NEAR(app::chi2_quantile_99(15) / 30.578, 1.0, 0.005);
+  EXPECT_NEAR(app::chi2_quantile_99(20) / 37.566, 1.0, 0.005);
+  EXPECT_NEAR(app::chi2_quantile_99(30) / 50.892, 1.0, 0.005);
+}
+
+// Pooled level errors: two levels whose seeds scatter as 1/√(grains) with one constant get their
+// own errors back; a level with few grains gets the larger error.
+TEST(Extrapolation, PooledErrorsScaleWithTheGrainsInTheCavity) {
+  // Level 1: 3 seeds, 400 grains, se 0.003; level 2: 3 seeds, 1600 grains, se 0.0015 (half).
+  const std::vector<double> pooled = app::pooled_stderr({{3, 0.003, 400}, {3, 0.0015, 1600}});
+  EXPECT_NEAR(pooled[0], 0.003, 1e-12);
+  EXPECT_NEAR(pooled[1], 0.0015, 1e-12);
+}
+
+// The cavity's features: the ring's annulus is 5 mm wide over most of its volume (its walls face
+// each other across it), a 1.2 mm slot 1.2 mm, and the disc has no feature narrower than its
+// 20 mm: its floor meets its wall at a convex edge, and its top is open. A ladder whose coarsest
+// grains are 2.26 mm is refused on the ring (2.2 grains across), naming α ≤ 10 (5 mm over five
+// 0.1 mm grains), and taken on the disc.
+TEST(Extrapolation, FeatureWidthsOfAnnulusSlotAndDisc) {
+  const double h = 0.25e-3;
+  const mesh::FeatureWidths ring = mesh::feature_widths(mesh::ring_cavity(20e-3, 10e-3, 10e-3, 1e-6), 0.0, h);
+  ASSERT_NE(ring.narrowest(), nullptr);
+  EXPECT_NEAR(ring.narrowest()->width, 5e-3, 2 * h);
+  EXPECT_GT(ring.share_below(5.5e-3), 0.4);
+  const mesh::FeatureWidths slot = mesh::feature_widths(mesh::box_solid(Vec3(-5e-3, -0.6e-3, -8e-3), Vec3(5e-3, 0.6e-3, 0)), 0.0, 0.1e-3);
+  ASSERT_NE(slot.narrowest(), nullptr);
+  EXPECT_NEAR(slot.narrowest()->width, 1.2e-3, 0.2e-3);
+  const mesh::FeatureWidths disc = mesh::feature_widths(mesh::ring_cavity(20e-3, 0, 10e-3, 1e-6), 0.0, h);
+  EXPECT_EQ(disc.share_below(19e-3), 0.0);
+  const app::Refusal r = app::refuse_thin_features(ring, 2.26e-3, 0.1e-3);
+  EXPECT_NE(r.reason.find("5 mm wide"), std::string::npos) << r.reason;
+  EXPECT_NEAR(r.alpha_needed, 10, 0.6);
+  EXPECT_TRUE(app::refuse_thin_features(disc, 2.26e-3, 0.1e-3).reason.empty());
 }
