@@ -394,14 +394,15 @@ TEST(Pipeline, FemHandOffHoldsTheCavitysMassAndItsWallLayer) {
 // A sweep over three shoe speeds: one folder per case, the summary table and chart; each case is
 // bit for bit the run `--set motion.speed=...` gives (the same final state and particle file).
 TEST(PipelineOwnRuns, SweepRunsEachCaseAsItsSingleRun) {
+  // The disc at 2.26 mm grains: what is asserted is that a case is its single run, bit for bit.
   const fs::path base = suite_out() / "sweep";
+  const std::string cache = "output.cache=" + (suite_out() / "sweep_cache").string();
   const auto load = [&](const std::vector<std::string>& more) {
-    std::vector<std::string> overrides = {"simulation.seed=1", "output.directory=" + base.string(),
-                                          "output.cache=" + (suite_out() / "a" / ".cache").string(), coarse,
-                                          "fem.elements=none"};
+    std::vector<std::string> overrides = {"simulation.seed=1", "output.directory=" + base.string(), cache, "powder.coarse_graining=22.6",
+                                          "motion.die_settle_time=0.01", "fem.elements=none"};
     overrides.insert(overrides.end(), more.begin(), more.end());
     app::PipelineScene scene = app::load_pipeline_scene(std::nullopt, overrides);
-    scene.die = bundled_die("ring");
+    scene.die = bundled_die("disc");
     return scene;
   };
   const app::Sweep sweep = app::parse_sweep("motion.speed=0.1,0.2,0.4");
@@ -409,13 +410,11 @@ TEST(PipelineOwnRuns, SweepRunsEachCaseAsItsSingleRun) {
   ASSERT_EQ(runs.size(), 3u);
   const double speeds[] = {0.1, 0.2, 0.4};
   for (std::size_t k = 0; k < 3; ++k) {
-    // The single runs: 0.1 m/s is the suite's base run; the others in folders of their own.
-    const std::string folder = k == 0 ? "a" : "single" + sweep.values[k];
-    const std::string shared_cache = " output.cache=" + (suite_out() / "a" / ".cache").string();
-    const nlohmann::json& single = run("ring", speeds[k], 1, folder, k == 0 ? coarse : coarse + shared_cache);
-    EXPECT_EQ(runs[k].dir, base / ("motion.speed=" + sweep.values[k]) / "ring");
+    const std::string folder = "single" + sweep.values[k];
+    const nlohmann::json& single = run("disc", speeds[k], 1, folder, "powder.coarse_graining=22.6 motion.die_settle_time=0.01 " + cache);
+    EXPECT_EQ(runs[k].dir, base / ("motion.speed=" + sweep.values[k]) / "disc");
     EXPECT_EQ(runs[k].report["final_state_sha256"], single["final_state_sha256"]) << "at " << speeds[k] << " m/s";
-    EXPECT_EQ(read_text(runs[k].dir / "particles.csv"), read_text(output_of("ring", folder) / "particles.csv")) << speeds[k];
+    EXPECT_EQ(read_text(runs[k].dir / "particles.csv"), read_text(output_of("disc", folder) / "particles.csv")) << speeds[k];
   }
   const std::string table = read_text(base / "sweep_motion.speed.csv");
   EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 4) << table;
@@ -496,11 +495,14 @@ TEST(Pipeline, OutputsReadBackThroughOtherToolsWithTheRightValues) {
 
 // Results do not depend on the thread count: the shoe settled and moved on two threads ends in
 // the very state (every position, velocity and contact history) one thread gives.
+// The disc at 2.26 mm grains (about 700, split over both threads' blocks): thread counts change
+// no bit whatever the scene's size (docs/ARCHITECTURE.md, "Model and state").
 TEST(PipelineOwnRuns, TwoThreadsGiveTheSameStateAndGrainsAsOne) {
-  const nlohmann::json& one = run("ring", 0.1, 1, "one_thread", coarse + " simulation.threads=1");
-  const nlohmann::json& two = run("ring", 0.1, 1, "two_threads", coarse + " simulation.threads=2");
+  const std::string tiny = "powder.coarse_graining=22.6 motion.die_settle_time=0.01";
+  const nlohmann::json& one = run("disc", 0.1, 1, "one_thread", tiny + " simulation.threads=1");
+  const nlohmann::json& two = run("disc", 0.1, 1, "two_threads", tiny + " simulation.threads=2");
   EXPECT_EQ(one["final_state_sha256"], two["final_state_sha256"]);
-  EXPECT_EQ(read_text(output_of("ring", "one_thread") / "particles.csv"), read_text(output_of("ring", "two_threads") / "particles.csv"));
+  EXPECT_EQ(read_text(output_of("disc", "one_thread") / "particles.csv"), read_text(output_of("disc", "two_threads") / "particles.csv"));
 }
 
 // docs/PHYSICS.md §3: below the critical speed the cavity fills to the powder's poured density; above
@@ -647,7 +649,7 @@ TEST(PipelineOwnRuns, InterruptedRunResumesToTheSameResult) {
 // rolling friction alone (μ_r = 0.1) rolls on for about ten centimetres: such grains may leave over the
 // table's end. They are counted as spilled (a leak through the die would have failed the run).
 TEST(PipelineOwnRuns, MorePassesFillAFastShoesDieFurther) {
-  const double once = run("disc", 0.4, 1, "passes")["fill"]["fill_ratio"].get<double>();
+  const double once = run("disc", 0.4, 1, "passes", coarse + " fem.elements=none")["fill"]["fill_ratio"].get<double>();
   const nlohmann::json& r = run("disc", 0.4, 1, "passes", coarse + " motion.passes=2 motion.return=true");
   const double twice = r["fill"]["fill_ratio"].get<double>();
   std::printf("disc at 0.4 m/s: fill ratio one pass %.4f, two passes with returns %.4f\n", once, twice);
@@ -664,14 +666,15 @@ TEST(PipelineOwnRuns, MorePassesFillAFastShoesDieFurther) {
 TEST(PipelineOwnRuns, FolderRunPassesOverFilesThatAreNotMeshes) {
   test::TempDir dir;
   fs::create_directories(dir / "dies");
-  fs::copy_file(bundled_die("ring"), dir / "dies" / "ring.stl");
+  fs::copy_file(bundled_die("disc"), dir / "dies" / "disc.stl");
   test::write_text(dir / "dies" / "README.md", "# my dies\n");
   test::write_text(dir / "dies" / "notes.log", "run at 9am\n");
-  const test::Run r = test::run_diefill("run " + (dir / "dies").string() + " --out " + (dir / "out").string() + " --set " + coarse +
+  const test::Run r = test::run_diefill("run " + (dir / "dies").string() + " --out " + (dir / "out").string() +
+                                        " --set powder.coarse_graining=22.6 --set fem.elements=none" +
                                         " --set motion.speed=0.4 --set motion.die_settle_time=0.01");
   EXPECT_EQ(r.status, 0) << r.output;
   const std::string summary = test::read_text(dir / "out" / "summary.csv");
-  EXPECT_NE(summary.find("ring,ok"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("disc,ok"), std::string::npos) << summary;
   EXPECT_EQ(summary.find("README"), std::string::npos) << summary;
   EXPECT_EQ(summary.find("notes"), std::string::npos) << summary;
 }
@@ -692,11 +695,11 @@ TEST(PipelineOwnRuns, SettledShoeIsRebuiltWhenASettlingKeyChanges) {
     for (const auto& e : fs::directory_iterator(suite_out() / "resettle" / ".cache")) n += e.path().filename().string().starts_with("shoe-");
     return n;
   };
-  const std::string fast = coarse + " motion.die_settle_time=0.01";
-  run("ring", 0.4, 1, "resettle", fast);
-  run("ring", 0.5, 1, "resettle", fast);
+  const std::string fast = "powder.coarse_graining=22.6 motion.die_settle_time=0.01";  // the cache's keys, not the fill
+  run("disc", 0.4, 1, "resettle", fast);
+  run("disc", 0.5, 1, "resettle", fast);
   EXPECT_EQ(shoes(), 1u) << "another speed reuses the settled shoe";
-  run("ring", 0.4, 1, "resettle", fast + " motion.shoe_settle_time=0.07");
+  run("disc", 0.4, 1, "resettle", fast + " motion.shoe_settle_time=0.07");
   EXPECT_EQ(shoes(), 2u) << "another settling time settles again";
 }
 

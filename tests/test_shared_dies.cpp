@@ -181,24 +181,6 @@ TEST(SharedDieOpenings, AreTheFacesThatOpenTheOutline) {
   EXPECT_EQ(mesh::up_name(opening("flanged_ring_trimesh_idler_riser.stl", mesh::LengthUnit::in)), "-z");
 }
 
-// The flanged ring opens on its flange plate (-z), whose face the file lacks: the winding-number
-// solid closes it flat in the plane of the face's rim, so the die has a flat top face to fill
-// through (before, the patch lay within a cell of that plane, not in it, and the die was refused).
-// At the voxels of the README's run of it (0.365 mm); at 0.8 mm a small shell of the file beside
-// the opening is re-meshed 0.19 mm proud of the plane, the box's top (README, "Shared dies through
-// the pipeline").
-TEST(SharedDieOpenings, AFaceMissingFromTheFileAtTheOpeningIsClosedFlat) {
-  REQUIRE_SHARED_MESHES();
-  mesh::DieOptions o = mesh::die_options_for_grains(0.5e-3, 0.25e-3, 0.365e-3);
-  o.unit = mesh::LengthUnit::in;
-  const mesh::PreparedDie die =
-      mesh::prepare_die(test::shared_meshes() / "dies" / "flanged_ring_trimesh_idler_riser.stl", o, std::nullopt);
-  EXPECT_EQ(mesh::up_name(die.up), "-z");
-  // The flat faces at the top (the opening) cover at least half of the part's outline, as
-  // find_opening asks of a top face (before, none lay flat there: the die was refused for it).
-  EXPECT_GE(mesh::opening_area(die.cavity, mesh::Up{2, 1}), 0.5 * mesh::shadow_area(die.cavity, 2));
-}
-
 // The planetary gear set's ring gear folds through itself where its profile's two ends meet: 98
 // pairs of slivers crossing within 2 µm of each other, at z = 0 and 15 mm. Welding the vertices
 // closer than a thousandth of the tolerance removes the folds and moves nothing farther than
