@@ -1,6 +1,7 @@
 // `diefill run TARGET`: the pipeline on a die mesh, on every mesh of a folder, or on a scene.
 // `diefill scene [TARGET]`: the resolved scene, every default with its reason.
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cctype>
@@ -13,6 +14,7 @@
 #include "pipeline/die_fill.hpp"
 #include "pipeline/ensemble.hpp"
 #include "pipeline/ladder.hpp"
+#include "pipeline/run_plan.hpp"
 #include "pipeline/preflight.hpp"
 #include "pipeline/sweep.hpp"
 #include "pipeline/run_loop.hpp"
@@ -120,6 +122,27 @@ int run_seed_ensemble(const RunCommand& c, const std::shared_ptr<dem::Exchange>&
                           ranks);
 }
 
+// The plan's chosen way, run as its command would run it.
+int run_planned(const RunCommand& c) {
+  if (fs::is_directory(c.target) || c.sweep || c.resume || c.ladder || c.seeds)
+    throw diefill::InputError("--plan", "", "chooses the grain size, seeds and ladder itself", "Give --plan without --ladder, --seeds, --sweep or --resume");
+  const Plan plan = make_plan(command_scene(c, {}), {c.accuracy, parse_duration(c.budget)});
+  fmt::print("{}", plan_table(plan));
+  if (!plan.chosen)
+    throw diefill::InputError("--budget", c.budget, "fits no way to the answer", "Raise --budget (`diefill plan` lists each way's time)");
+  const PlanOption& chosen = plan.options[*plan.chosen];
+  RunCommand run = c;
+  run.plan = false;
+  if (chosen.kind == "ladder") {
+    run.ladder = fmt::format("{}", fmt::join(chosen.alphas, ","));
+  } else {
+    run.overrides.push_back(fmt::format("powder.coarse_graining={}", chosen.alphas.front()));
+    if (chosen.seeds > 1) run.seeds = chosen.seeds;
+  }
+  if (chosen.kind == "ladder") run.seeds = chosen.seeds;
+  return run_pipeline(run);
+}
+
 int run_grain_ladder(const RunCommand& c, const std::shared_ptr<dem::Exchange>& ranks) {
   refuse_beside_many_runs(c, "--ladder");
   Ladder ladder = parse_ladder(*c.ladder);
@@ -133,6 +156,13 @@ int run_grain_ladder(const RunCommand& c, const std::shared_ptr<dem::Exchange>& 
 }
 
 }  // namespace
+
+int run_plan(const PlanCommand& c) {
+  const Plan plan = make_plan(command_scene(c.run, {}), {c.run.accuracy, parse_duration(c.run.budget)});
+  fmt::print("{}", plan_table(plan));
+  if (!c.json.empty()) diefill::write_file_atomic(c.json, plan_json(plan).dump(2) + "\n");
+  return 0;
+}
 
 int run_scene(const SceneCommand& c) {
   if (c.keys) {
@@ -163,6 +193,7 @@ int run_pipeline(const RunCommand& c) {
   // Under mpirun every rank runs this; rank 0 reports (pipeline/die_fill.hpp).
   const std::shared_ptr<dem::Exchange> ranks = mpi_exchange();
   const bool root = !ranks || ranks->rank() == 0;
+  if (c.plan) return run_planned(c);
   if (c.ladder) return run_grain_ladder(c, ranks);
   if (c.extrapolate_to) throw diefill::InputError("--extrapolate-to", "", "extrapolates a ladder", "Give --ladder A1,A2,A3 with it");
   if (c.seeds && *c.seeds != 1) return run_seed_ensemble(c, ranks);

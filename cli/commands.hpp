@@ -44,8 +44,18 @@ struct RunCommand {
   std::optional<std::string> ladder;     // A1,A2,A3: a grain-size ladder (pipeline/ladder.hpp)
   std::optional<double> extrapolate_to;  // the ladder's answer at this α (default 1: the real powder)
   std::optional<std::string> sweep;  // KEY=V1,V2,...: one run per value (pipeline/sweep.hpp)
+  bool plan = false;                 // run what `diefill plan` chooses (pipeline/run_plan.hpp)
+  double accuracy = 0.01;            // the plan's standard error of the fill ratio
+  std::string budget = "30m";        // the plan's wall time
 };
 int run_pipeline(const RunCommand& command);
+
+// `diefill plan TARGET`: the run's options and the cheapest that meets the accuracy in the budget.
+struct PlanCommand {
+  RunCommand run;                  // its target, --set, --threads, --out
+  std::filesystem::path json;      // also write the plan here
+};
+int run_plan(const PlanCommand& command);
 
 struct CompareCommand {
   std::filesystem::path run_a, run_b;

@@ -57,10 +57,25 @@ void add_run(CLI::App& root, app::RunCommand& c, std::function<int()>& action) {
                   "Run the scene at three or more coarse-graining levels (A1,A2,A3), each a seed ensemble, and extrapolate "
                   "the fill to the powder's real size");
   cmd->add_option("--extrapolate-to", c.extrapolate_to, "With --ladder: the coarse graining to extrapolate to (default 1)");
+  cmd->add_flag("--plan", c.plan, "Run what `diefill plan` chooses for --accuracy within --budget");
+  cmd->add_option("--accuracy", c.accuracy, "With --plan: the standard error of the fill ratio asked for")->capture_default_str();
+  cmd->add_option("--budget", c.budget, "With --plan: the wall time allowed (90s, 30m, 2h, 1h30m)")->capture_default_str();
   cmd->add_option("--sweep", c.sweep,
                   "Run once per value of a scene key, each into OUT/KEY=VALUE/, with a summary table and chart: "
                   "--sweep motion.speed=0.05,0.1,0.2");
   cmd->callback([&] { action = [&] { return app::run_pipeline(c); }; });
+}
+
+void add_plan(CLI::App& root, app::PlanCommand& c, std::function<int()>& action) {
+  CLI::App* cmd = root.add_subcommand("plan", "What each grain size would take and miss by, and the cheapest way to an accuracy");
+  cmd->add_option("TARGET", c.run.target, "Die mesh or scene (.toml)")->required();
+  cmd->add_option("--set", c.run.overrides, "Override a scene key");
+  cmd->add_option("--accuracy", c.run.accuracy, "The standard error of the fill ratio asked for")->capture_default_str();
+  cmd->add_option("--budget", c.run.budget, "The wall time allowed on this machine (90s, 30m, 2h, 1h30m)")->capture_default_str();
+  cmd->add_option("--threads", c.run.threads, "Threads the runs would take (default: all cores)");
+  cmd->add_option("--out", c.run.out, "Where the runs would write (its .cache holds this machine's timings)");
+  cmd->add_option("--json", c.json, "Also write the plan as JSON to this file");
+  cmd->callback([&] { action = [&] { return app::run_plan(c); }; });
 }
 
 void add_scene(CLI::App& root, app::SceneCommand& c, std::function<int()>& action) {
@@ -185,6 +200,8 @@ int main(int argc, char** argv) {
   add_run(root, run, action);
   app::SceneCommand scene;
   add_scene(root, scene, action);
+  app::PlanCommand plan;
+  add_plan(root, plan, action);
   app::SimulateCommand simulate;
   add_simulate(root, simulate, action);
   app::BenchCommand bench;

@@ -12,6 +12,7 @@
 #include "pipeline/preflight.hpp"
 #include "pipeline/shoe_fill.hpp"
 #include "pipeline/shoe_pass.hpp"
+#include "pipeline/throughput.hpp"
 #include "pipeline/walls.hpp"
 
 namespace app {
@@ -88,6 +89,9 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
   check_losses(census, source.file.source, walls.die.name);
   const FillRecord record{s, walls, grains, shoe, *settled, *fill, census, source.table_z, clock.seconds(), ranks ? ranks->ranks() : 1};
   run.report = write_fill_outputs(record, run.dir);
+  if (!ranks || ranks->ranks() == 1)  // the plan's model is one process's
+    record_timing(walls.cache, settled->particle_steps + double(fill->loop.steps) * double(fill->state.size()), clock.seconds(),
+                  omp_get_max_threads());
   run.cavity_grains = census.cavity;
   run.fill_curve = fill->curve;
   return run;

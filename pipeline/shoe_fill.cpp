@@ -100,7 +100,7 @@ std::size_t insert_round(const Insertion& in, dem::State& bed, std::size_t count
 
 // Settles the bed for shoe.settle_time at the scene's time step (the settling shoe sees no fall
 // into the die, so runs differing in the die's depth or the shoe's speed reuse it). False on Ctrl-C.
-bool settle(const Insertion& in, dem::State& bed, const std::string& label) {
+bool settle(const Insertion& in, dem::State& bed, const std::string& label, double& particle_steps) {
   dem::ModelSpec spec = in.walls.spec;
   spec.max_impact_speed = in.scene.spec.max_impact_speed;
   const dem::Model model = dem::compile_model(spec, bed, in.scene.source);
@@ -111,7 +111,9 @@ bool settle(const Insertion& in, dem::State& bed, const std::string& label) {
   loop.until = in.scene.shoe_settle_time;
   loop.label = label;
   loop.max_steps = in.scene.max_steps;
-  return !run_until(model, bed, loop).interrupted;
+  const LoopResult result = run_until(model, bed, loop);
+  particle_steps += double(result.steps) * double(bed.exchange ? bed.exchange->sum(std::int64_t(bed.owned())) : std::int64_t(bed.size()));
+  return !result.interrupted;
 }
 
 std::optional<SettledShoe> settle_afresh(const Insertion& in, const std::string& die_name) {
@@ -126,7 +128,7 @@ std::optional<SettledShoe> settle_afresh(const Insertion& in, const std::string&
                        in.clump ? fmt::format("clumps of {} spheres", in.clump->spheres.size()) : "grains",
                        in.grains.diameter * 1e3, in.shoe.length * 1e3, in.shoe.width * 1e3, in.clump ? "" : ", once; cached");
     // Interrupted while settling: nothing is cached (a half-settled shoe must never be reused).
-    if (!settle(in, out.state, die_name + ": settling the shoe")) return std::nullopt;
+    if (!settle(in, out.state, die_name + ": settling the shoe", out.particle_steps)) return std::nullopt;
   }
   if (out.inserted < out.requested)
     diefill::log::warn("{}: the shoe holds {} of the {} grains that fill it to shoe.fill_height = {:.4g} mm; raise shoe.height or "
@@ -184,6 +186,7 @@ std::optional<SettledShoe> fill_and_settle_shoe(const PipelineScene& s, const Fi
   if (!out.from_cache) {
     const std::optional<SettledShoe> settled = settle_afresh(in, walls.die.name);
     if (!settled) return std::nullopt;
+    out.particle_steps = settled->particle_steps;
     fs::create_directories(walls.cache);
     dem::with_whole_state(settled->state, [&](const dem::State& whole) { dem::write_particles_csv(whole, file); });
   }

@@ -28,6 +28,7 @@ struct SettledShoe {
   std::size_t requested = 0;   // grains for shoe.fill_height
   std::size_t inserted = 0;   // over every rank
   bool from_cache = false;
+  double particle_steps = 0;  // grains × steps the settling took (0 from the cache): the plan's timings
 };
 // nullopt when Ctrl-C stopped the settling (nothing is cached then). Split over ranks (non-null
 // `ranks`), the grains are settled split, and the state returned is this rank's share.

@@ -11,6 +11,8 @@
 #include "mesh/shapes.hpp"
 #include "pipeline/ensemble.hpp"
 #include "pipeline/extrapolate.hpp"
+#include "pipeline/run_plan.hpp"
+#include "core/error.hpp"
 #include "postprocess/ensemble_stats.hpp"
 
 using Vec3 = Eigen::Vector3d;
@@ -186,4 +188,14 @@ TEST(Extrapolation, FeatureWidthsOfAnnulusSlotAndDisc) {
   EXPECT_NE(r.reason.find("5 mm wide"), std::string::npos) << r.reason;
   EXPECT_NEAR(r.alpha_needed, 10, 0.6);
   EXPECT_TRUE(app::refuse_thin_features(disc, 2.26e-3, 0.1e-3).reason.empty());
+}
+
+// `--budget`'s durations, and what is not one.
+TEST(Plan, DurationsParse) {
+  EXPECT_EQ(app::parse_duration("90"), 90);
+  EXPECT_EQ(app::parse_duration("90s"), 90);
+  EXPECT_EQ(app::parse_duration("30m"), 1800);
+  EXPECT_EQ(app::parse_duration("2h"), 7200);
+  EXPECT_EQ(app::parse_duration("1h30m"), 5400);
+  for (const char* bad : {"", "3 days", "h", "-5m", "0"}) EXPECT_THROW(app::parse_duration(bad), diefill::InputError) << bad;
 }

@@ -740,3 +740,30 @@ TEST(PipelineOwnRuns, SeedEnsembleIsTheMeanOfItsSeedsRuns) {
   EXPECT_NE(read_text(out / "disc" / "fem" / "fill.vtu").find("Name=\"solid_fraction_stderr\""), std::string::npos);
   EXPECT_NE(read_text(out / "disc" / "fill_curve.csv").find("mass_in_cavity_kg_stderr"), std::string::npos);
 }
+
+// `diefill plan` on the ring (docs/INTERFACE.md, "Plans"): every grain size's run as `diefill
+// scene` sizes it (the default's 16,042 grains and 79,957 pass steps), a predicted time for each,
+// the annulus as the narrowest part (5 mm), the sizes with fewer than five grains across it
+// marked, and a chosen command.
+TEST(PipelineOwnRuns, PlanPredictsEachGrainSizesRunAndChoosesOne) {
+  const fs::path dir = suite_out() / "plan";
+  const test::Run r = test::run_diefill("plan " + bundled_die("ring").string() + " --out " + dir.string() + " --json " +
+                                        (dir / "plan.json").string() + " --accuracy 0.02 --budget 10m");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const nlohmann::json plan = nlohmann::json::parse(read_text(dir / "plan.json"));
+  EXPECT_NEAR(plan["narrowest_tenth_m"].get<double>(), 5e-3, 0.3e-3);
+  bool default_size = false;
+  for (const auto& level : plan["levels"]) {
+    EXPECT_GT(level["predicted_wall_s"].get<double>(), 0);
+    EXPECT_EQ(level["affine"].get<bool>(), level["grains_across_narrowest"].get<double>() >= 5);
+    if (level["coarse_graining"].get<double>() == 8) {
+      default_size = true;
+      EXPECT_EQ(level["grains"], 16042);
+      EXPECT_EQ(level["pass_steps"], 79957);
+    }
+  }
+  EXPECT_TRUE(default_size);
+  ASSERT_FALSE(plan["chosen"].is_null()) << r.output;
+  EXPECT_TRUE(plan["chosen"]["command"].get<std::string>().starts_with("diefill run ")) << plan["chosen"].dump();
+  EXPECT_LE(plan["chosen"]["predicted_wall_s"].get<double>(), 600);
+}
