@@ -4,6 +4,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cctype>
 #include <set>
 #include <string_view>
@@ -137,7 +138,13 @@ int run_planned(const RunCommand& c) {
     run.ladder = fmt::format("{}", fmt::join(chosen.alphas, ","));
   } else {
     run.overrides.push_back(fmt::format("powder.coarse_graining={}", chosen.alphas.front()));
-    if (chosen.seeds > 1) run.seeds = chosen.seeds;
+    if (chosen.seeds > 1) {
+      // As its command says: finer voxels for the seeds (pipeline/run_plan.cpp).
+      const double d = chosen.alphas.front() * command_scene(c, {}).particle_diameter;
+      run.seeds = chosen.seeds;
+      run.overrides.push_back(fmt::format("density.voxel={:.3g}", 2 * d / std::cbrt(double(chosen.seeds))));
+      run.overrides.push_back(fmt::format("fem.element_size={:.3g}", 2 * d));
+    }
   }
   if (chosen.kind == "ladder") run.seeds = chosen.seeds;
   return run_pipeline(run);

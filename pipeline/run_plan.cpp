@@ -64,9 +64,13 @@ double ladder_stderr(const std::vector<const PlanLevel*>& levels, int seeds, dou
   return fit_affine(points).stderr_at(target);
 }
 
-std::string single_command(const PipelineScene& s, double alpha, int seeds) {
-  return fmt::format("diefill run {} --set powder.coarse_graining={}{}", s.die.string(), alpha,
-                     seeds > 1 ? fmt::format(" --seeds {}", seeds) : "");
+// One size's run; with N seeds on voxels finer by N^(1/3): one run's noise per voxel falls as
+// 1/√(grains per voxel), so N seeds on voxels of 2d/N^(1/3) are as noisy as one on 2d (the
+// default), and resolve features N^(1/3) times finer; the elements stay at 2d.
+std::string single_command(const PipelineScene& s, double alpha, double diameter, int seeds) {
+  if (seeds == 1) return fmt::format("diefill run {} --set powder.coarse_graining={}", s.die.string(), alpha);
+  return fmt::format("diefill run {} --set powder.coarse_graining={} --seeds {} --set density.voxel={:.3g} --set fem.element_size={:.3g}",
+                     s.die.string(), alpha, seeds, 2 * diameter / std::cbrt(double(seeds)), 2 * diameter);
 }
 
 std::vector<PlanOption> options_of(const PipelineScene& s, const std::vector<PlanLevel>& levels, const PlanRequest& r) {
@@ -79,7 +83,7 @@ std::vector<PlanOption> options_of(const PipelineScene& s, const std::vector<Pla
     if (l.bias < a) o.seeds = std::clamp(int(std::ceil(l.seed_stderr * l.seed_stderr / (a * a - l.bias * l.bias))), 1, most_seeds);
     o.stderr_ = std::hypot(l.seed_stderr / std::sqrt(double(o.seeds)), l.bias);
     o.predicted_s = o.seeds * l.predicted_s;
-    o.command = single_command(s, l.alpha, o.seeds);
+    o.command = single_command(s, l.alpha, l.diameter_m, o.seeds);
     out.push_back(o);
   }
   for (std::size_t k = 0; k + 2 < levels.size(); ++k) {
