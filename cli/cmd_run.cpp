@@ -134,6 +134,11 @@ int run_planned(const RunCommand& c) {
   const PlanOption& chosen = plan.options[*plan.chosen];
   RunCommand run = c;
   run.plan = false;
+  // The plan sized each grain size without the grain budget: the run may take what it chose.
+  std::size_t grains = command_scene(c, {}).max_grains;
+  for (const PlanLevel& l : plan.levels)
+    if (std::find(chosen.alphas.begin(), chosen.alphas.end(), l.alpha) != chosen.alphas.end()) grains = std::max(grains, l.size.grains + 1);
+  run.overrides.push_back(fmt::format("powder.max_grains={}", grains));
   if (chosen.kind == "ladder") {
     run.ladder = fmt::format("{}", fmt::join(chosen.alphas, ","));
   } else {

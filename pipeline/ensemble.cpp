@@ -10,6 +10,7 @@
 #include "core/log.hpp"
 #include "core/sha256.hpp"
 #include "core/timer.hpp"
+#include "dem/distributed.hpp"
 #include "pipeline/fem_stage.hpp"
 #include "pipeline/outputs.hpp"
 #include "pipeline/sweep.hpp"
@@ -108,12 +109,37 @@ nlohmann::json ensemble_report(const std::vector<DieRun>& runs, const FillProduc
   report["stability"] = {{"max_overlap_rel", overlap}, {"max_energy_gain", energy}, {"checks", checks},
                          {"checks_passed", std::all_of(checks.begin(), checks.end(), [](const auto& c) { return c.template get<bool>(); })},
                          {"warnings", warnings}};
+  for (const std::string& w : diefill::log::take_warnings()) report["stability"]["warnings"].push_back(w);  // the ensemble's own
   std::vector<std::uint64_t> numbers;
   for (const std::string& s : seeds) numbers.push_back(std::stoull(s));
   report["run"]["seeds"] = numbers;
   report["timing"]["wall_s"] = wall_s;
   report["final_state_sha256"] = diefill::sha256_hex(hashes);
   report["ensemble"] = {{"seeds", seeds.size()}, {"runs", folders}};
+  return report;
+}
+
+// The ensemble's outputs into `dir`, from the seeds' runs (rank 0's, which holds their grains).
+nlohmann::json write_ensemble(const PipelineScene& first, const std::vector<DieRun>& runs, const std::vector<std::string>& seeds,
+                              const diefill::Stopwatch& clock, const fs::path& dir) {
+  for (std::size_t k = 0; k < runs.size(); ++k)
+    if (runs[k].cavity_grains.empty())
+      throw diefill::InputError(runs[k].dir.string(), "particles.in_cavity", fmt::format("seed {} put no grain into the cavity", seeds[k]),
+                                "Look at that seed's run: an ensemble of it has no mean field");
+  // The seeds' setting, as the sweep ran them (one cache), from the cache the runs filled.
+  PipelineScene scene = first;
+  if (scene.cache.empty()) scene.cache = first.out / ".cache";
+  const FillSetup setup = set_up_fill(scene, scene.die);
+  Realisations realisations;
+  for (const DieRun& r : runs) realisations.cavity.push_back(r.cavity_grains), realisations.curves.push_back(r.fill_curve);
+  diefill::StagingFolder out(dir);
+  const FillProducts products = write_fill_products({scene, setup.walls, setup.grains, setup.shoe}, realisations, out.path());
+  const nlohmann::json report = ensemble_report(runs, products, seeds, clock.seconds());
+  diefill::write_file_atomic(out / "scene.toml", describe(scene));
+  diefill::write_file_atomic(out / "report.json", report.dump(2) + "\n");
+  out.commit();
+  diefill::log::info("{}: {} seeds, fill ratio {:.4f} ± {:.4f} (standard error) -> {}", runs.front().die, seeds.size(),
+                     products.fill.value("fill_ratio", 0.0), products.fill.value("fill_ratio_stderr", 0.0), dir.string());
   return report;
 }
 
@@ -133,22 +159,10 @@ DieRun run_ensemble(const std::function<PipelineScene(const std::vector<std::str
   ensemble.die = runs.front().die;
   ensemble.dir = first.out / ensemble.die;
   ensemble.interrupted = runs.size() < values.size() || runs.back().interrupted;
-  if (ensemble.interrupted || (ranks && ranks->rank() != 0)) return ensemble;
-
-  // The seeds' setting, as the sweep ran them (one cache), from the cache the runs filled.
-  PipelineScene scene = first;
-  if (scene.cache.empty()) scene.cache = first.out / ".cache";
-  const FillSetup setup = set_up_fill(scene, scene.die);
-  Realisations realisations;
-  for (const DieRun& r : runs) realisations.cavity.push_back(r.cavity_grains), realisations.curves.push_back(r.fill_curve);
-  diefill::StagingFolder out(ensemble.dir);
-  const FillProducts products = write_fill_products({scene, setup.walls, setup.grains, setup.shoe}, realisations, out.path());
-  ensemble.report = ensemble_report(runs, products, values, clock.seconds());
-  diefill::write_file_atomic(out / "scene.toml", describe(scene));
-  diefill::write_file_atomic(out / "report.json", ensemble.report.dump(2) + "\n");
-  out.commit();
-  diefill::log::info("{}: {} seeds, fill ratio {:.4f} ± {:.4f} (standard error) -> {}", ensemble.die, seeds,
-                     products.fill.value("fill_ratio", 0.0), products.fill.value("fill_ratio_stderr", 0.0), ensemble.dir.string());
+  if (ensemble.interrupted) return ensemble;
+  // Rank 0 writes; should that fail, every rank learns it before a ladder's next level.
+  dem::run_and_agree(ranks.get(), !ranks || ranks->rank() == 0,
+                     [&] { ensemble.report = write_ensemble(first, runs, values, clock, ensemble.dir); });
   return ensemble;
 }
 

@@ -16,6 +16,7 @@ AffineFit fit_affine(const std::vector<LevelValue>& levels) {
   if (levels.size() < 3) throw std::invalid_argument("an affine fit with an error needs three levels or more");
   double s = 0, sx = 0, sxx = 0, sy = 0, sxy = 0;
   for (const LevelValue& l : levels) {
+    if (!(l.stderr_ > 0)) throw std::invalid_argument("a level without a standard error: its seeds gave one value");
     const double w = 1 / (l.stderr_ * l.stderr_);
     s += w, sx += w * l.diameter_m, sxx += w * l.diameter_m * l.diameter_m, sy += w * l.value, sxy += w * l.diameter_m * l.value;
   }
@@ -49,6 +50,7 @@ std::vector<double> pooled_stderr(const std::vector<LevelSpread>& levels) {
     dof += double(l.seeds - 1);
   }
   if (!(dof > 0)) throw std::invalid_argument("pooled errors need two seeds of a level or more");
+  if (!(squares > 0)) throw std::invalid_argument("no level's seeds differ: no noise to pool");
   std::vector<double> out;
   for (const LevelSpread& l : levels) out.push_back(std::sqrt(squares / dof / (l.grains_in_cavity * double(l.seeds))));
   return out;

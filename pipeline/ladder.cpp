@@ -93,9 +93,12 @@ void check_levels(const std::function<PipelineScene(const std::vector<std::strin
 // Each level's figure at `pointer` with its pooled standard error (extrapolate.hpp).
 std::vector<LevelValue> level_values(const std::vector<Level>& levels, int seeds, const std::string& pointer) {
   std::vector<LevelSpread> spreads;
-  for (const Level& l : levels)
-    spreads.push_back({seeds, l.report.at(nlohmann::json::json_pointer(pointer + "_stderr")).get<double>(),
+  for (const Level& l : levels) {
+    // A figure the level's seeds all gave alike has no _stderr beside it: its error is 0 there.
+    const nlohmann::json::json_pointer error(pointer + "_stderr");
+    spreads.push_back({seeds, l.report.contains(error) ? l.report.at(error).get<double>() : 0.0,
                        l.report.at("/particles/in_cavity"_json_pointer).get<double>()});
+  }
   const std::vector<double> pooled = pooled_stderr(spreads);
   std::vector<LevelValue> out;
   for (std::size_t k = 0; k < levels.size(); ++k)
@@ -151,8 +154,13 @@ std::string write_extrapolation(const std::vector<Level>& levels, const Ladder& 
   block["to_grain_diameter_m"] = target;
   block["model"] = "affine in the grain diameter (docs/PHYSICS.md §4.1)";
   block["refused"] = refused.empty() ? nlohmann::json(nullptr) : nlohmann::json(refused);
-  for (const auto& [name, region] : levels.front().report.at("fill").at("regions").items())
-    block["regions"][name] = fit_json(fit_affine(level_values(levels, ladder.seeds, "/fill/regions/" + name + "/fill_ratio")), target);
+  for (const auto& [name, region] : levels.front().report.at("fill").at("regions").items()) {
+    try {
+      block["regions"][name] = fit_json(fit_affine(level_values(levels, ladder.seeds, "/fill/regions/" + name + "/fill_ratio")), target);
+    } catch (const std::invalid_argument& e) {  // a region no seed of any level varied in
+      block["regions"][name] = {{"refused", e.what()}};
+    }
+  }
   std::string csv = "coarse_graining,grain_diameter_m,seeds,fill_ratio,fill_ratio_stderr,grains_in_cavity,residual,folder\n";
   const std::vector<LevelValue> values = level_values(levels, ladder.seeds, "/fill/fill_ratio");
   for (std::size_t k = 0; k < levels.size(); ++k) {

@@ -126,10 +126,11 @@ Plan make_plan(const PipelineScene& scene, const PlanRequest& request) {
   const DieSource die = read_die(scene, scene.die);
   plan.die = die.file.name;
   const ShoePlan shoe = plan_shoe(scene, die);
-  const double volume = std::abs(mesh::signed_volume(die.file.mesh)), walls = wall_area(die.file.mesh, die.table_z);
   const mesh::Box box = mesh::bounding_box(die.file.mesh);
-  plan.narrowest_feature_m = narrowest_tenth(
-      mesh::feature_widths(die.file.mesh, die.table_z, std::max(box.size().minCoeff() / 16, std::cbrt(box.size().prod() / 5e5))));
+  const mesh::FeatureWidths widths =
+      mesh::feature_widths(die.file.mesh, die.table_z, std::max(box.size().minCoeff() / 16, std::cbrt(box.size().prod() / 5e5)));
+  plan.narrowest_feature_m = narrowest_tenth(widths);
+  const double volume = widths.cavity_volume, walls = wall_area(die.file.mesh, die.table_z);
   const fs::path cache = scene.cache.empty() ? scene.out / ".cache" : scene.cache;
   plan.kernel_rate = kernel_rate(scene, size_grains(scene, shoe, plan.die), cache);
   const TimeModel model = time_model(cache, plan.kernel_rate);

@@ -309,7 +309,7 @@ struct WallLayerLattice {
 
 // The FEM hand-off's elements against the truth: each element's solid fraction sampled at 2,000
 // random points of its part of the cavity (σ = 0.0098 for φ = 0.74), on the ring's 1.6 mm elements
-// from sub-voxels of 1.4 sphere radii (a run's: one grain radius). The void layer along the walls stays in the elements there
+// from sub-voxels of 1.4 sphere radii (a run's are half a grain radius: this is the harder case). The void layer along the walls stays in the elements there
 // (an average wider than the elements, as the hand-off once took, read it as the interior: issue
 // 44): elements at the side walls and at the floor read their layers' truth to 1 % on average,
 // while that truth lies 7 % and 15 % below the interior's. Per element the hand-off adds at most
