@@ -211,13 +211,13 @@ nlohmann::json statistics_json(const post::FieldStatistics& st) {
           {"regions", regions}};
 }
 
-void write_density(const DensityResult& r, const fs::path& dir) {
+void write_density(const DensityResult& r, const fs::path& dir, bool pictures) {
   const post::DensityField* smoothed = r.smoothed ? &*r.smoothed : nullptr;
   post::write_vdb(r.field, smoothed, dir / "density.vdb");
   post::write_vti(r.field, dir / "density.vti");
   if (smoothed) post::write_vti(*smoothed, dir / "density_smoothed.vti");
   post::write_plot_data(r.field, r.stats, smoothed, smoothed ? &r.smoothed_stats : nullptr, r.outlines, dir / "plot_data.json");
-  draw_pictures({"density", dir.string()});
+  if (pictures) draw_pictures({"density", dir.string()});
 }
 
 }  // namespace app

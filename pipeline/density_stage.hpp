@@ -56,6 +56,6 @@ DensityResult mean_density(const std::vector<DensityResult>& seeds);
 nlohmann::json statistics_json(const post::FieldStatistics& stats);
 
 // density.vdb, density.vti, plot_data.json and the pictures into `dir` (a staging folder).
-void write_density(const DensityResult& result, const std::filesystem::path& dir);
+void write_density(const DensityResult& result, const std::filesystem::path& dir, bool pictures = true);
 
 }  // namespace app

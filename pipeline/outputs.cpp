@@ -51,7 +51,7 @@ nlohmann::json write_density_field(const FillSetting& c, const Realisations& r, 
     fields.push_back(compute_density(grains, c.walls.die, *c.walls.die_field, powder_density(c.walls), ds, c.walls.die.name));
     figures.push_back(statistics_json(fields.back().stats));
   }
-  write_density(fields.size() == 1 ? fields.front() : mean_density(fields), dir);
+  write_density(fields.size() == 1 ? fields.front() : mean_density(fields), dir, c.scene.pictures);
   nlohmann::json fill = figures.size() == 1 ? figures.front() : mean_with_stderr(figures);
   fill["voxel_m"] = ds.voxel_m;
   fill["smoothed_width_m"] = ds.smoothed_width_m;
@@ -85,7 +85,7 @@ nlohmann::json write_fill_curve_outputs(const FillSetting& c, const Realisations
     const auto [curve, band] = mean_curve(r.curves);
     write_fill_curve(curve, capacity, dir / "fill_curve.csv", &band);
   }
-  draw_pictures({"fill_curve", (dir / "fill_curve.csv").string(), fmt::format("{:.9g}", strike_off)});
+  if (c.scene.pictures) draw_pictures({"fill_curve", (dir / "fill_curve.csv").string(), fmt::format("{:.9g}", strike_off)});
   return {{"cavity_capacity_kg", capacity},
           {"strike_off_s", strike_off},
           {"curve", "fill_curve.csv"}};

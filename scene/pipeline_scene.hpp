@@ -50,6 +50,7 @@ struct PipelineScene {
   int threads = 0;
   bool force = false;                 // `--force`: run a size over the limit (pipeline/preflight.hpp); no key
   std::int64_t max_steps = 0;         // a smoke run: every DEM stage ends after this many steps (the scene fuzz test); no key
+  bool pictures = true;               // false: no PNGs (smoke runs, the studies' scratch runs nobody looks at); no key
   // [density]
   double density_voxel = 0;           // [m]; 0: two grain diameters
   std::string density_method = "exact";

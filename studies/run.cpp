@@ -45,9 +45,11 @@ int run_study(const StudyRequest& c) {
     throw diefill::InputError("", "NAME", fmt::format("there is no study \"{}\"", c.name), "Choose one of: " + known);
   }
   PipelineScene scene = load_pipeline_scene(c.scene, c.overrides);
-  // The studies read fills and flows, not FEM decks: no hand-off, whose mesh and CalculiX run
-  // would add seconds to each of their many runs.
+  // The studies read fills and flows, not FEM decks or their runs' pictures: no hand-off, whose
+  // mesh and CalculiX run would add seconds to each of their many runs, and no pictures (python,
+  // about 1.5 s a run); the study draws its own charts.
   scene.fem_elements = "none";
+  scene.pictures = false;
   if (c.threads) scene.threads = *c.threads;
   if (c.seed) scene.seed = *c.seed;
   if (scene.threads > 0) omp_set_num_threads(scene.threads);

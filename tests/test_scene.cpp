@@ -170,6 +170,7 @@ TEST(SceneKeys, MutatedScenesThatLoadRunOrStopClearly) {
     s.max_steps = 30;
     s.max_grains = std::min<std::size_t>(s.max_grains, 1500);
     s.fem_compaction = "none";
+    s.pictures = false;
     try {
       const app::DieRun run = app::run_die_fill(s, s.die, false);
       EXPECT_FALSE(run.interrupted);

@@ -74,12 +74,12 @@ TEST(Study, DischargeFollowsTheBeverlooSlotLawAndTheCriticalVelocityLaw) {
 }
 
 // Repose (1.6 mm grains; the scene's powder, μ = 0.5 and μ_r = 0.1, then μ = 0.1 and no rolling
-// friction; six heaps and three drained beds of other seeds each): both angles rise with either
-// friction by more than two combined standard errors (a test of a difference, so its errors
-// belong in it; each angle's error is its beds' scatter, or their fits' where that is larger, and
-// an outflow angle's fit error counts the disagreement of its two slopes). Zhou et al.'s
-// correlation is a trend from another bench (docs/PHYSICS.md §3), so the scene's angles need only
-// lie within 5° of it.
+// friction; six heaps (three at μ = 0.1, whose rise is 11°) and three drained beds of other seeds
+// each): both angles rise with either friction by more than two combined standard errors (a
+// test of a difference, so its errors belong in it; each angle's error is its beds' scatter, or
+// their fits' where that is larger, and an outflow angle's fit error counts the disagreement of
+// its two slopes). Zhou et al.'s correlation is a trend from another bench (docs/PHYSICS.md §3),
+// so the scene's angles need only lie within 5° of it.
 TEST(Study, ReposeAnglesRiseWithFrictionNearTheZhouCorrelation) {
   const nlohmann::json r = run_reduced("repose");
   const auto run_with = [&](double sliding, double rolling) {
