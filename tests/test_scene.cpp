@@ -149,7 +149,7 @@ TEST(SceneKeys, MutatedScenesLoadOrAreRefusedClearly) {
 }
 
 // Past loading (issue 44): every mutated scene that loads runs on the disc as a smoke run (every
-// DEM stage cut at 30 steps, at most 1,500 grains: coarse, as its keys allow) and completes or
+// DEM stage cut at 30 steps, at most 400 grains: coarse, as its keys allow) and completes or
 // stops with InputError or StabilityError, which `diefill` turns into exit status 2 or 3 with the
 // message; never another exception, a crash or a hang (and, in the sanitizer stage, no undefined
 // behaviour). The run's checks before its first step are those of `diefill scene`.
@@ -168,7 +168,7 @@ TEST(SceneKeys, MutatedScenesThatLoadRunOrStopClearly) {
     s.out = dir / "out";
     s.cache = dir / "cache";
     s.max_steps = 30;
-    s.max_grains = std::min<std::size_t>(s.max_grains, 1500);
+    s.max_grains = std::min<std::size_t>(s.max_grains, 400);
     s.fem_compaction = "none";
     s.pictures = false;
     try {
