@@ -25,11 +25,17 @@ bool launched_by_mpi() { return std::getenv("OMPI_COMM_WORLD_SIZE") || std::gete
 
 MpiSession::MpiSession(int& argc, char**& argv) {
   if (!launched_by_mpi()) return;
-  MPI_Init(&argc, &argv);
+  // OpenMP threads compute between the exchanges, which the main thread alone makes: FUNNELED is
+  // what the standard asks of such a program (MPI_Init promises only SINGLE).
+  int provided = MPI_THREAD_SINGLE;
+  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
   session_exchange = dem::make_mpi_exchange();
   // One progress line, one set of warnings and one result: rank 0's (a warning comes from values
   // every rank shares). Errors still come from every rank.
   if (session_exchange->rank() != 0) diefill::log::set_level(diefill::log::Level::quiet);
+  if (provided < MPI_THREAD_FUNNELED)
+    diefill::log::warn("this MPI library gives no thread support (MPI_THREAD_FUNNELED); run one OpenMP thread per rank "
+                       "(OMP_NUM_THREADS=1)");
 }
 MpiSession::~MpiSession() {
   if (!session_exchange) return;

@@ -152,6 +152,12 @@ std::string write_extrapolation(const std::vector<Level>& levels, const Ladder& 
   block = fit_json(fit, target);
   block["to_coarse_graining"] = target_alpha;
   block["to_grain_diameter_m"] = target;
+  // Extrapolated to a coarser size than the powder's (to check the ladder against a run there),
+  // the same line still answers for the real powder: said beside it.
+  if (target_alpha != 1) {
+    const double real = target / target_alpha;
+    block["real_powder"] = {{"grain_diameter_m", real}, {"fill_ratio", fit.at(real)}, {"fill_ratio_stderr", fit.stderr_at(real)}};
+  }
   block["model"] = "affine in the grain diameter (docs/PHYSICS.md §4.1)";
   block["refused"] = refused.empty() ? nlohmann::json(nullptr) : nlohmann::json(refused);
   for (const auto& [name, region] : levels.front().report.at("fill").at("regions").items()) {

@@ -670,7 +670,8 @@ TEST(MpiChunked, MessagesInPiecesGiveTheSameBits) {
 }
 
 int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
+  int provided = 0;  // as diefill asks (cli/mpi_session.cpp)
+  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
   ::testing::InitGoogleTest(&argc, argv);
   const int failed = RUN_ALL_TESTS();
   int any = 0;
