@@ -19,9 +19,9 @@ else
   "$root/build/diefill" run "$root/dies/$die.stl" --set "powder.coarse_graining=$next" --out "$work/next" >&2
 fi
 next_s=$(($(date +%s) - start))
-/usr/bin/python3 - "$work" "$die" "$levels" "$next" "$ladder_s" "$next_s" "$root" <<'PY'
+/usr/bin/python3 - "$work" "$die" "$levels" "$next" "$seeds" "$ladder_s" "$next_s" "$root" <<'PY'
 import json, math, shutil, sys
-work, die, levels, nxt, ladder_s, next_s, root = sys.argv[1:]
+work, die, levels, nxt, seeds, ladder_s, next_s, root = sys.argv[1:]
 e = json.load(open(f"{work}/ladder/{die}/report.json"))["extrapolation"]
 nrep = json.load(open(f"{work}/next/{die}/report.json"))
 f = nrep["fill"]
