@@ -24,13 +24,14 @@ plan = json.load(open(f"{work}/plan_ring.json"))
 truth, truth_se = real["fill_ratio"], real["fill_ratio_stderr"]
 rows = [r for r in csv.DictReader(open(f"{root}/bench/results/speed_accuracy_default.csv")) if r["outcome"] == "ran"]
 runs = []
-for r in rows:
+for r in rows:  # the plan grid rounds α to three digits (11.3 for 8√2)
     alpha = float(r["coarse_graining"])
-    level = next((l for l in plan["levels"] if abs(l["coarse_graining"] - alpha) < 1e-6), None)
-    plain = float(r["stiffness_factor"]) == 1 and abs(float(r["time_step_fraction"]) - 0.15) < 1e-9
+    level = next((l for l in plan["levels"] if abs(l["coarse_graining"] / alpha - 1) < 5e-3), None)
+    plain = (float(r["stiffness_factor"]) == 1 and abs(float(r["time_step_fraction"]) - 0.15) < 1e-9 and
+             abs(float(r["die_voxel_fraction"]) - 0.25) < 1e-9)
     run = {"setting": r["setting"], "group": r["group"], "coarse_graining": alpha, "wall_s": float(r["wall_s"]),
            "fill_ratio": float(r["fill_ratio"]), "error_against_real_powder": float(r["fill_ratio"]) - truth}
-    if level is not None and plain:  # the plan models the grain size, not softening or the step
+    if level is not None and plain:  # the plan models the grain size, not softening, the step or the wall voxels
         run["plan_predicted_wall_s"] = level["predicted_wall_s"]
         run["plan_bias"] = -level["bias"]  # the plan's fill minus the real powder's
         run["plan_seed_stderr"] = level["fill_ratio_stderr_one_seed"]
