@@ -66,6 +66,8 @@ const nlohmann::json& run(const std::string& die, double speed, std::uint64_t se
   // unless they ask for it.
   if (grains != coarse && grains.find("fem.elements") == std::string::npos) overrides.push_back("fem.elements=none");
   app::PipelineScene scene = app::load_pipeline_scene(std::nullopt, overrides);
+  // Pictures are looked at on the plain runs only (python, a few seconds a run).
+  scene.pictures = folder == "a" && grains == coarse;
   const app::DieRun r = app::run_die_fill(scene, bundled_die(die), false);
   EXPECT_FALSE(r.interrupted);
   return done[key] = r.report;
@@ -404,6 +406,7 @@ TEST(PipelineOwnRuns, SweepRunsEachCaseAsItsSingleRun) {
     overrides.insert(overrides.end(), more.begin(), more.end());
     app::PipelineScene scene = app::load_pipeline_scene(std::nullopt, overrides);
     scene.die = bundled_die("disc");
+    scene.pictures = false;  // the sweep's own chart is drawn regardless
     return scene;
   };
   const app::Sweep sweep = app::parse_sweep("motion.speed=0.1,0.2,0.4");

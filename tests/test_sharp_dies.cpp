@@ -46,6 +46,7 @@ TEST_P(SharpFeatureDie, FillsWithNoGrainInsideTheDieSolid) {
   app::PipelineScene scene = app::load_pipeline_scene(
       std::nullopt, {fmt::format("powder.coarse_graining={}", d.coarse_graining), "output.snapshot_every=0.05",
                      "output.directory=" + (dir / "out").string()});
+  scene.pictures = false;  // nothing here looks at them
   const app::DieRun run = app::run_die_fill(scene, dir / (std::string(d.name) + ".stl"), false);
   ASSERT_FALSE(run.interrupted);
   // No grain left through the die: the run stops with an error naming it (pipeline/census.cpp).
