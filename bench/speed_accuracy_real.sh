@@ -22,6 +22,8 @@ root, work = sys.argv[1:]
 real = json.load(open(f"{root}/bench/results/ladder_ring.json"))["real_powder"]
 plan = json.load(open(f"{work}/plan_ring.json"))
 truth, truth_se = real["fill_ratio"], real["fill_ratio_stderr"]
+def distance(level):  # the plan's expected distance of one seed from the real powder
+    return math.hypot(level["bias"], level["fill_ratio_stderr_one_seed"])
 rows = [r for r in csv.DictReader(open(f"{root}/bench/results/speed_accuracy_default.csv")) if r["outcome"] == "ran"]
 runs = []
 for r in rows:  # the plan grid rounds α to three digits (11.3 for 8√2)
@@ -35,7 +37,7 @@ for r in rows:  # the plan grid rounds α to three digits (11.3 for 8√2)
         run["plan_predicted_wall_s"] = level["predicted_wall_s"]
         run["plan_bias"] = -level["bias"]  # the plan's fill minus the real powder's
         run["plan_seed_stderr"] = level["fill_ratio_stderr_one_seed"]
-        run["plan_predicted_distance"] = math.hypot(level["bias"], level["fill_ratio_stderr_one_seed"])
+        run["plan_predicted_distance"] = distance(level)
     runs.append(run)
 out = {"command": "bench/speed_accuracy_real.sh", "real_powder_fill_ratio": truth, "real_powder_fill_ratio_stderr": truth_se,
        "real_powder_from": "bench/results/ladder_ring.json", "runs": runs}
@@ -48,9 +50,9 @@ for group in dict.fromkeys(r["group"] for r in runs):
     ax.scatter(xs, ys, label=f"{group} (measured)")
 levels = sorted((l for l in plan["levels"] if l["coarse_graining"] >= 4), key=lambda l: l["predicted_wall_s"])
 ax.plot([l["predicted_wall_s"] for l in levels],
-        [100 * math.hypot(l["bias"], l["fill_ratio_stderr_one_seed"]) for l in levels], "k--", label="plan: one seed per grain size")
+        [100 * distance(l) for l in levels], "k--", label="plan: one seed per grain size")
 for l in levels:
-    ax.annotate(f"α {l['coarse_graining']:.3g}", (l["predicted_wall_s"], 100 * math.hypot(l["bias"], l["fill_ratio_stderr_one_seed"])),
+    ax.annotate(f"α {l['coarse_graining']:.3g}", (l["predicted_wall_s"], 100 * distance(l)),
                 fontsize=7, textcoords="offset points", xytext=(3, 3))
 ax.axhspan(0, 100 * truth_se, color="0.85", label="real powder's answer: its standard error")
 ax.set_xscale("log")
