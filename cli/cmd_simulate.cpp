@@ -56,23 +56,22 @@ int run_simulate(const SimulateCommand& c) {
   loop.checkpoint = checkpoint;
   loop.resumed = c.resume;
   loop.output_origin = start_time;
-  // Every rank gathers (collective); rank 0 alone holds the trajectory's file.
+  // Every rank gathers (collective); rank 0 alone holds the trajectory's file, whose rows go in id order.
   if (scene.output.trajectory)
     loop.outputs.push_back({scene.output.trajectory_every, [&](const dem::State& s) {
                               dem::with_whole_state(s, [&](const dem::State& whole) {
                                 if (trajectory) trajectory->write(whole);
                               });
                             }});
+  // Split over ranks, each rank writes its own grains (a .pvtu and its pieces).
   if (scene.output.snapshot_every > 0)
     loop.outputs.push_back({scene.output.snapshot_every, [&](const dem::State& s) {
-                              dem::with_whole_state(s, [&](const dem::State& whole) {
-                                dem::write_vtu(whole, dir / fmt::format("snapshot_{:05d}.vtu", snapshot++));
-                              });
+                              dem::write_vtu(s, dir / fmt::format("snapshot_{:05d}.vtu", snapshot++));
                             }});
   install_interrupt_handler();
   const LoopResult result = run_until(model, state, loop);
   const std::int64_t lost = ranks ? ranks->sum(state.lost) : state.lost;
-  dem::with_whole_state(state, [&](const dem::State& whole) { dem::write_particles_csv(whole, dir / "particles.csv"); });
+  dem::write_particles_csv(state, dir / "particles.csv");
   if (!root) return result.interrupted ? diefill::exit_interrupted : diefill::exit_ok;
   const nlohmann::json summary = {
       {"grains", grains},

@@ -1,10 +1,11 @@
 #include "dem/checkpoint.hpp"
 
+#include <fmt/core.h>
+
 #include <algorithm>
 #include <cstring>
 #include <fstream>
-#include <unordered_map>
-#include <unordered_set>
+#include <numeric>
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
@@ -14,17 +15,21 @@ namespace dem {
 
 namespace {
 
-constexpr char magic[8] = {'D', 'F', 'C', 'K', 'P', 'T', '0', '6'};
-constexpr char split_magic[8] = {'D', 'F', 'C', 'K', 'S', 'P', '0', '3'};
+namespace fs = std::filesystem;
 
+constexpr char magic[8] = {'D', 'F', 'C', 'K', 'P', 'T', '0', '7'};
+constexpr char split_magic[8] = {'D', 'F', 'C', 'K', 'S', 'P', '0', '4'};
+constexpr char piece_magic[8] = {'D', 'F', 'C', 'K', 'P', 'C', '0', '4'};
+
+// Streams straight into the file: a rank's piece of ten million grains is never held twice.
 struct Writer {
-  std::string bytes;
+  std::ofstream out;
   template <typename T>
-  void value(const T& v) { bytes.append(reinterpret_cast<const char*>(&v), sizeof v); }
+  void value(const T& v) { out.write(reinterpret_cast<const char*>(&v), sizeof v); }
   template <typename T, typename A>
   void array(const std::vector<T, A>& v) {
     value(std::uint64_t(v.size()));
-    bytes.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+    out.write(reinterpret_cast<const char*>(v.data()), std::streamsize(v.size() * sizeof(T)));
   }
 };
 
@@ -100,214 +105,261 @@ void fields(IO& io, S& s) {
   io.value(s.energy_reference_set);
   io.value(s.loop_max_overlap_rel);
   io.value(s.loop_max_energy_gain);
+  // The checks the next step makes of this one (dem/step.cpp), and a split rank's ghosts.
+  io.value(s.counters.max_overlap_rel);
+  io.value(s.counters.wall_power);
+  io.value(s.counters.energy_gain);
+  io.value(s.counters.checked_overlap_rel);
+  io.value(s.counters.contacts);
+  io.value(s.counters.wall_contacts);
+  io.value(s.ghosts);
+  io.array(s.carried_pairs);
 }
 
-// A run split over ranks, as one rank-count-free image: grains in id order with the forces of the
-// last step (the next step's first half kick needs them), their wall contacts and pair histories
-// keyed by global ids, and the clumps' bodies with their members' ids. Its lists are not kept: the first step after it builds them, and carries
-// the histories into them by id.
-struct CheckpointGrain {
-  GrainRecord grain;
-  Vec3 f, torque;
-};
-// A grain's wall slots, each laid out as a WallSlot with its padding named (as GrainRecord's).
-struct SlotRecord {
-  std::int64_t id;
-  struct {
-    std::int32_t wall, unused;
-    Vec3 normal;
-    ContactHistory history;
-  } slot[wall_slots_per_particle];
-};
-static_assert(sizeof(SlotRecord) == sizeof(std::int64_t) + wall_slots_per_particle * sizeof(WallSlot));
-struct SplitImage {
-  double time = 0, wall_work = 0, energy_reference = 0, energy_scale = 0, loop_max_overlap_rel = 0, loop_max_energy_gain = 0;
+// A split run's checkpoint (docs/ARCHITECTURE.md, "Domain decomposition"): every rank writes its
+// own piece, `PATH.rank-R-of-N`, which is the rank's whole state (owned grains, ghosts, lists with
+// their histories, wall contacts, counters) as a single process writes it, and what its exchange
+// knows; rank 0 writes the index, PATH, last. The same rank count resumes each piece on its rank
+// and goes on bit for bit; another count shares the pieces out and takes their owned grains with
+// their histories keyed by global ids (the first step builds the lists and the subdomains anew).
+struct SplitIndex {
+  std::uint64_t ranks = 0;
   std::int64_t step = 0, lost = 0;
+  double time = 0, wall_work = 0, energy_reference = 0, energy_scale = 0, loop_max_overlap_rel = 0, loop_max_energy_gain = 0;
   std::uint8_t energy_reference_set = 0;
-  std::vector<CheckpointGrain> grains;
-  std::vector<SlotRecord> slots;
-  std::vector<CarriedPair> pairs;
-  BodiesImage bodies;
 };
 
 template <typename IO, typename I>
-void split_fields(IO& io, I& image) {
-  io.value(image.time);
-  io.value(image.wall_work);
-  io.value(image.energy_reference);
-  io.value(image.energy_scale);
-  io.value(image.step);
-  io.value(image.lost);
-  io.value(image.energy_reference_set);
-  io.value(image.loop_max_overlap_rel);
-  io.value(image.loop_max_energy_gain);
-  io.array(image.grains);
-  io.array(image.slots);
-  io.array(image.pairs);
-  io.array(image.bodies.bodies);
-  io.array(image.bodies.members);
+void index_fields(IO& io, I& index) {
+  io.value(index.ranks);
+  io.value(index.step);
+  io.value(index.lost);
+  io.value(index.time);
+  io.value(index.wall_work);
+  io.value(index.energy_reference);
+  io.value(index.energy_scale);
+  io.value(index.loop_max_overlap_rel);
+  io.value(index.loop_max_energy_gain);
+  io.value(index.energy_reference_set);
 }
 
-// The owned grains' share of the image, as bytes for rank 0.
-void put_owned(const State& s, std::vector<char>& grains, std::vector<char>& slots, std::vector<char>& pairs) {
-  for (std::size_t i = 0; i < s.owned(); ++i) {
-    CheckpointGrain g;
-    std::memset(static_cast<void*>(&g), 0, sizeof g);  // padding too: the same state, the same file
-    g.grain = grain_record(s, i), g.f = s.f[i], g.torque = s.torque[i];
-    put(grains, g);
+fs::path piece_path(const fs::path& index, std::uint64_t rank, std::uint64_t ranks) {
+  return fs::path(index).concat(fmt::format(".rank-{}-of-{}", rank, ranks));
+}
+
+void write_head(Writer& w, const char (&kind)[8], const Model& model) {
+  w.out.write(kind, sizeof kind);
+  w.out.write(model.hash.data(), std::streamsize(model.hash.size()));
+}
+
+// Writes through a temporary sibling, renamed into place when complete.
+void write_atomically(const fs::path& path, const std::function<void(Writer&)>& write) {
+  diefill::PendingFile pending(path);
+  {
+    Writer w{std::ofstream(pending.path(), std::ios::binary)};
+    write(w);
+    if (!w.out) throw diefill::InputError(path.string(), "", "cannot be written", "Check that the folder is writable and the disk is not full");
   }
-  const NeighbourList& nl = s.neighbours;
-  if (s.wall_slots.size() == nl.near_wall.size() * wall_slots_per_particle)
-    for (std::size_t q = 0; q < nl.near_wall.size(); ++q) {
-      SlotRecord r;
-      std::memset(static_cast<void*>(&r), 0, sizeof r);
-      r.id = s.id[std::size_t(nl.near_wall[q])];
-      for (int k = 0; k < wall_slots_per_particle; ++k) {
-        const WallSlot& slot = s.wall_slots[q * wall_slots_per_particle + std::size_t(k)];
-        r.slot[k].wall = slot.wall, r.slot[k].normal = slot.normal, r.slot[k].history = slot.history;
-      }
-      put(slots, r);
-    }
-  for (const auto& of_grain : contact_histories(s))
-    for (const CarriedPair& c : of_grain) put(pairs, c);
+  pending.commit();
 }
 
-template <typename T>
-std::vector<T> records(const std::vector<char>& bytes) {
-  std::vector<T> out;
-  out.reserve(bytes.size() / sizeof(T));
-  for (const char* at = bytes.data(); at < bytes.data() + bytes.size();) out.push_back(take<T>(at));
-  return out;
-}
-
-// Collective on a split state; the image is complete on rank 0 (or a single process) only.
-SplitImage image_of(const State& s) {
-  SplitImage image;
-  image.time = s.time, image.wall_work = s.wall_work, image.step = s.step;
-  image.energy_reference = s.energy_reference, image.energy_scale = s.energy_scale;
-  image.energy_reference_set = s.energy_reference_set;
-  image.loop_max_overlap_rel = s.loop_max_overlap_rel, image.loop_max_energy_gain = s.loop_max_energy_gain;  // global on every rank
-  image.lost = s.exchange ? s.exchange->sum(s.lost) : s.lost;
-  std::vector<char> grains, slots, pairs;
-  put_owned(s, grains, slots, pairs);
-  if (s.exchange) grains = s.exchange->gather(grains), slots = s.exchange->gather(slots), pairs = s.exchange->gather(pairs);
-  image.grains = records<CheckpointGrain>(grains);
-  image.slots = records<SlotRecord>(slots);
-  image.pairs = records<CarriedPair>(pairs);
-  image.bodies = gathered_bodies(s);
-  // In id order, so that the file is the same whichever rank held which grain.
-  std::sort(image.grains.begin(), image.grains.end(), [](const auto& a, const auto& b) { return a.grain.id < b.grain.id; });
-  std::sort(image.slots.begin(), image.slots.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
-  std::sort(image.pairs.begin(), image.pairs.end(),
-            [](const auto& a, const auto& b) { return a.id != b.id ? a.id < b.id : a.partner < b.partner; });
-  return image;
-}
-
-// This rank's share of the image (share_indices, as share_of), ready to step.
-State share_of_image(const SplitImage& image, std::shared_ptr<Exchange> exchange) {
-  State s;
-  for (const CheckpointGrain& g : image.grains) {
-    append_grain(s, g.grain);
-    s.f.back() = g.f, s.torque.back() = g.torque;
-  }
-  append_bodies(s, image.bodies);
-  keep_grains(s, share_indices(s, *exchange));
-  std::unordered_map<std::int64_t, std::size_t> index;
-  for (std::size_t i = 0; i < s.size(); ++i) index.emplace(s.id[i], i);
-  for (const SlotRecord& r : image.slots)
-    if (const auto at = index.find(r.id); at != index.end()) {
-      s.neighbours.near_wall.push_back(std::int32_t(at->second));
-      for (const auto& slot : r.slot) s.wall_slots.push_back({slot.wall, slot.normal, slot.history});
-    }
-  for (const CarriedPair& c : image.pairs)
-    if (index.count(c.id)) s.carried_pairs.push_back(c);
-  s.time = image.time, s.step = image.step, s.wall_work = image.wall_work;
-  s.lost = exchange->rank() == 0 ? image.lost : 0;
-  s.energy_reference = image.energy_reference, s.energy_scale = image.energy_scale;
-  s.energy_reference_set = image.energy_reference_set != 0;
-  s.loop_max_overlap_rel = image.loop_max_overlap_rel, s.loop_max_energy_gain = image.loop_max_energy_gain;
-  s.exchange = std::move(exchange);
-  return s;
-}
-
-// Every clump names members that the image holds, at least one each.
-bool bodies_match_grains(const SplitImage& image) {
-  std::unordered_set<std::int64_t> ids;
-  for (const CheckpointGrain& g : image.grains) ids.insert(g.grain.id);
-  std::size_t members = 0;
-  for (const BodyRecord& b : image.bodies.bodies) {
-    if (b.members <= 0) return false;
-    members += std::size_t(b.members);
-  }
-  if (members != image.bodies.members.size()) return false;
-  return std::all_of(image.bodies.members.begin(), image.bodies.members.end(), [&](const MemberRecord& m) { return ids.count(m.id) > 0; });
-}
-
-std::string read_head(Reader& r, const Model& model, const std::filesystem::path& path) {
+void check_head(Reader& r, const char (&kind)[8], const Model& model, const fs::path& path) {
   char head[sizeof magic];
   std::string hash(model.hash.size(), '\0');
   r.in.read(head, sizeof head);
   r.in.read(hash.data(), std::streamsize(hash.size()));
-  const std::string kind(head, sizeof head);
-  if (r.in && kind != std::string(magic, sizeof magic) && kind != std::string(split_magic, sizeof split_magic) &&
-      (kind.starts_with("DFCKPT") || kind.starts_with("DFCKSP")))
+  const std::string found(head, sizeof head), wanted(kind, sizeof kind);
+  if (r.in && found != wanted && found.starts_with("DFCK"))
     throw diefill::InputError(path.string(), "", "the checkpoint was written by another version of diefill",
                               "Start afresh (without --resume)");
-  if (!r.in || (kind != std::string(magic, sizeof magic) && kind != std::string(split_magic, sizeof split_magic)))
-    throw diefill::InputError(path.string(), "", "not a diefill checkpoint", "Name a checkpoint file diefill wrote");
+  if (!r.in || found != wanted) throw diefill::InputError(path.string(), "", "not a diefill checkpoint", "Name a checkpoint file diefill wrote");
   if (hash != model.hash)
     throw diefill::InputError(path.string(), "model", "the checkpoint was written by a different scene or build",
                               "Resume with the scene that wrote it, or start afresh");
-  return kind;
 }
 
-// The file read on this rank: the whole state of a single-process checkpoint, or (with an
-// exchange) this rank's share of either kind.
-State read_whole_or_split(const Model& model, const std::filesystem::path& path, std::shared_ptr<Exchange> exchange) {
+// Whether the file is a split run's index (else a single process's checkpoint, or an error).
+bool is_split(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  char head[sizeof magic] = {};
+  in.read(head, sizeof head);
+  return in && std::memcmp(head, split_magic, sizeof head) == 0;
+}
+
+// A piece's (or a single process's) state and what its exchange saved.
+struct Piece {
+  State state;
+  std::vector<char> exchange;
+};
+
+Piece read_piece(const Model& model, const fs::path& path, const SplitIndex* index, std::uint64_t rank) {
   Reader r{std::ifstream(path, std::ios::binary)};
-  const bool split = read_head(r, model, path) == std::string(split_magic, sizeof split_magic);
-  if (split && !exchange)
+  if (!r.in)
+    throw diefill::InputError(path.string(), "", "cannot be read (a piece of the split checkpoint is missing)",
+                              "Keep every PATH.rank-R-of-N file beside the checkpoint, or start afresh");
+  check_head(r, index ? piece_magic : magic, model, path);
+  Piece piece;
+  std::uint64_t written_rank = rank, written_ranks = index ? index->ranks : 1;
+  std::int64_t step = 0;
+  if (index) r.value(written_rank), r.value(written_ranks), r.value(step);
+  fields(r, piece.state);
+  if (index) r.array(piece.exchange);
+  if (!r.in) throw diefill::InputError(path.string(), "", "the checkpoint is truncated", "Start afresh");
+  if (index && (written_rank != rank || written_ranks != index->ranks || step != index->step))
+    throw diefill::InputError(path.string(), "", "the piece belongs to another checkpoint than its index (a run ended while writing it)",
+                              "Start afresh");
+  // The cross pairs' force buffers are scratch, refilled by the next force stage.
+  piece.state.cross_forces.force.assign(piece.state.neighbours.cross_reverse.size(), Vec3::Zero());
+  piece.state.cross_forces.torque.assign(piece.state.neighbours.cross_reverse.size(), Vec3::Zero());
+  return piece;
+}
+
+// Appends a piece's owned grains to `s`, with their forces, clumps, wall contacts and pair
+// histories (by global id, for the next build); its ghosts and lists are left behind.
+void append_owned(State& s, State piece) {
+  std::vector<CarriedPair> pairs;
+  for (const auto& of_grain : contact_histories(piece)) pairs.insert(pairs.end(), of_grain.begin(), of_grain.end());
+  const NeighbourList& nl = piece.neighbours;
+  const auto first = std::int32_t(s.size());
+  if (piece.wall_slots.size() == nl.near_wall.size() * wall_slots_per_particle)
+    for (std::size_t q = 0; q < nl.near_wall.size(); ++q) {
+      s.neighbours.near_wall.push_back(first + nl.near_wall[q]);
+      s.wall_slots.insert(s.wall_slots.end(), piece.wall_slots.begin() + std::ptrdiff_t(q * wall_slots_per_particle),
+                          piece.wall_slots.begin() + std::ptrdiff_t((q + 1) * wall_slots_per_particle));
+    }
+  std::vector<std::size_t> owned(piece.owned());
+  std::iota(owned.begin(), owned.end(), std::size_t{0});
+  keep_grains(piece, owned);
+  for (std::size_t i = 0; i < piece.size(); ++i) {
+    append_grain(s, grain_record(piece, i));
+    s.f.back() = piece.f[i], s.torque.back() = piece.torque[i];
+  }
+  const Bodies& B = piece.bodies;
+  std::vector<std::int32_t> member;
+  for (std::size_t b = 0; b < B.size(); ++b) {
+    member.clear();
+    for (std::int32_t k = B.member_start[b]; k < B.member_start[b + 1]; ++k) member.push_back(first + B.member[std::size_t(k)]);
+    append_body(s, body_record(B, b), member.data(), &B.offset[std::size_t(B.member_start[b])]);
+  }
+  s.carried_pairs.insert(s.carried_pairs.end(), pairs.begin(), pairs.end());
+  s.counters.max_overlap_rel = std::max(s.counters.max_overlap_rel, piece.counters.max_overlap_rel);
+  s.counters.checked_overlap_rel = std::max(s.counters.checked_overlap_rel, piece.counters.checked_overlap_rel);
+}
+
+// This rank's state from `pieces` pieces written by as many ranks (1: a single process's file):
+// on the same rank count its own piece as it was; on another, every ranks-th piece's owned grains
+// from its rank on, the run's totals (grains lost, the walls' work) on rank 0.
+State restore_split(const Model& model, const fs::path& path, const SplitIndex* index, std::shared_ptr<Exchange> exchange) {
+  const auto rank = std::uint64_t(exchange->rank()), ranks = std::uint64_t(exchange->ranks());
+  const std::uint64_t pieces = index ? index->ranks : 1;
+  const auto piece_file = [&](std::uint64_t p) { return index ? piece_path(path, p, pieces) : path; };
+  if (pieces == ranks && index) {
+    Piece own = read_piece(model, piece_file(rank), index, rank);
+    exchange->restore(own.exchange.data(), own.exchange.size());
+    own.state.exchange = std::move(exchange);
+    return std::move(own.state);
+  }
+  State s;
+  s.neighbours.near_wall.clear();
+  bool scalars = false;
+  for (std::uint64_t p = rank; p < pieces; p += ranks) {
+    Piece piece = read_piece(model, piece_file(p), index, p);
+    if (!scalars) {
+      s.time = piece.state.time, s.step = piece.state.step;
+      s.energy_reference = piece.state.energy_reference, s.energy_scale = piece.state.energy_scale;
+      s.energy_reference_set = piece.state.energy_reference_set;
+      s.loop_max_overlap_rel = piece.state.loop_max_overlap_rel, s.loop_max_energy_gain = piece.state.loop_max_energy_gain;
+      scalars = true;
+    }
+    s.lost += piece.state.lost, s.wall_work += piece.state.wall_work;
+    append_owned(s, std::move(piece.state));
+  }
+  if (index) {
+    s.time = index->time, s.step = index->step;
+    s.energy_reference = index->energy_reference, s.energy_scale = index->energy_scale;
+    s.energy_reference_set = index->energy_reference_set != 0;
+    s.loop_max_overlap_rel = index->loop_max_overlap_rel, s.loop_max_energy_gain = index->loop_max_energy_gain;
+    s.lost = rank == 0 ? index->lost : 0;
+    s.wall_work = rank == 0 ? index->wall_work : 0;
+  }
+  s.exchange = std::move(exchange);
+  return s;
+}
+
+State read_any(const Model& model, const fs::path& path, std::shared_ptr<Exchange> exchange) {
+  if (!is_split(path)) {
+    if (!exchange) return std::move(read_piece(model, path, nullptr, 0).state);
+    return restore_split(model, path, nullptr, std::move(exchange));
+  }
+  if (!exchange)
     throw diefill::InputError(path.string(), "", "the checkpoint was written by a run split over MPI ranks",
                               "Resume it under mpirun, on any number of ranks (`mpirun -np 1` too)");
-  State s;
-  SplitImage image;
-  if (split) split_fields(r, image);
-  else fields(r, s);
-  if (!r.in) throw diefill::InputError(path.string(), "", "the checkpoint is truncated", "Start afresh");
-  if (split && !bodies_match_grains(image))
-    throw diefill::InputError(path.string(), "", "the checkpoint's clumps name grains it does not hold (a damaged file)", "Start afresh");
-  if (exchange) return share_of_image(split ? image : image_of(s), std::move(exchange));
-  // The cross pairs' force buffers are scratch, refilled by the next force stage.
-  s.cross_forces.force.assign(s.neighbours.cross_reverse.size(), Vec3::Zero());
-  s.cross_forces.torque.assign(s.neighbours.cross_reverse.size(), Vec3::Zero());
-  return s;
+  Reader r{std::ifstream(path, std::ios::binary)};
+  check_head(r, split_magic, model, path);
+  SplitIndex index;
+  index_fields(r, index);
+  if (!r.in || index.ranks == 0) throw diefill::InputError(path.string(), "", "the checkpoint is truncated", "Start afresh");
+  return restore_split(model, path, &index, std::move(exchange));
+}
+
+// Removes the pieces that checkpoints at this path wrote for another rank count (0: for any).
+void remove_pieces(const fs::path& path, std::uint64_t but_of_ranks) {
+  const std::string prefix = path.filename().string() + ".rank-", own = fmt::format("-of-{}", but_of_ranks);
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(path.parent_path().empty() ? fs::path(".") : path.parent_path(), ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.starts_with(prefix) && (but_of_ranks == 0 || !name.ends_with(own)) && name.find(".tmp-") == std::string::npos)
+      fs::remove(entry.path(), ec);
+  }
 }
 
 }  // namespace
 
 void write_checkpoint(const Model& model, const State& state, const std::filesystem::path& path) {
-  Writer w;
   if (!state.exchange) {
-    w.bytes.append(magic, sizeof magic);
-    w.bytes.append(model.hash);
-    fields(w, state);
-    diefill::write_file_atomic(path, w.bytes);
+    write_atomically(path, [&](Writer& w) {
+      write_head(w, magic, model);
+      fields(w, state);
+    });
     return;
   }
-  SplitImage image = image_of(state);
-  run_and_agree(state.exchange.get(), writes_outputs(state), [&] {
-    w.bytes.append(split_magic, sizeof split_magic);
-    w.bytes.append(model.hash);
-    split_fields(w, image);
-    diefill::write_file_atomic(path, w.bytes);
+  Exchange& exchange = *state.exchange;
+  SplitIndex index;
+  index.ranks = std::uint64_t(exchange.ranks());
+  index.step = state.step, index.time = state.time;
+  index.lost = exchange.sum(state.lost), index.wall_work = exchange.sum(state.wall_work);
+  index.energy_reference = state.energy_reference, index.energy_scale = state.energy_scale;
+  index.energy_reference_set = state.energy_reference_set;
+  index.loop_max_overlap_rel = state.loop_max_overlap_rel, index.loop_max_energy_gain = state.loop_max_energy_gain;
+  const auto rank = std::uint64_t(exchange.rank());
+  const std::vector<char> saved = exchange.saved();
+  run_and_agree(&exchange, true, [&] {
+    write_atomically(piece_path(path, rank, index.ranks), [&](Writer& w) {
+      write_head(w, piece_magic, model);
+      w.value(rank), w.value(index.ranks), w.value(index.step);
+      fields(w, state);
+      w.array(saved);
+    });
+  });
+  run_and_agree(&exchange, writes_outputs(state), [&] {
+    write_atomically(path, [&](Writer& w) {
+      write_head(w, split_magic, model);
+      index_fields(w, index);
+    });
+    remove_pieces(path, index.ranks);
   });
 }
 
 State read_checkpoint(const Model& model, const std::filesystem::path& path, std::shared_ptr<Exchange> exchange) {
-  // Every rank reads the file; should one fail, all stop.
+  // Every rank reads its part; should one fail, all stop.
   State s;
-  run_and_agree(exchange.get(), true, [&] { s = read_whole_or_split(model, path, exchange); });
+  run_and_agree(exchange.get(), true, [&] { s = read_any(model, path, exchange); });
   return s;
+}
+
+void remove_checkpoint(const std::filesystem::path& path) {
+  remove_pieces(path, 0);
+  fs::remove(path);
 }
 
 }  // namespace dem

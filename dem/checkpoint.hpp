@@ -3,10 +3,12 @@
 // counters) plus the hash of the Model that made it. A run resumed from one continues
 // bit-for-bit like the uninterrupted run.
 //
-// Split over MPI ranks (exchange.hpp), a checkpoint holds the grains in id order with their
-// contact histories keyed by global ids, gathered on rank 0 and written by it: any number of
-// ranks can resume it (each takes its share; the first step builds the lists anew), with the same
-// statistics, not the same bits, as the run that wrote it.
+// Split over MPI ranks (exchange.hpp), every rank writes its own piece beside the file
+// (PATH.rank-R-of-N: its grains, ghosts, lists and histories, and what its exchange knows) and
+// rank 0 the file itself, an index: no rank holds another's grains. The same rank count resumes
+// it bit for bit; any other count too (each rank takes every N-th piece's own grains, with their
+// histories keyed by global ids; the first step builds the lists and subdomains anew), with the
+// same statistics, not the same bits.
 #include <filesystem>
 #include <memory>
 
@@ -21,5 +23,8 @@ void write_checkpoint(const Model& model, const State& state, const std::filesys
 // exchange (every rank reads the file), this rank's share, ready to step; without, the whole
 // state of a single-process checkpoint.
 State read_checkpoint(const Model& model, const std::filesystem::path& path, std::shared_ptr<Exchange> exchange = nullptr);
+
+// Removes a checkpoint and its pieces.
+void remove_checkpoint(const std::filesystem::path& path);
 
 }  // namespace dem

@@ -166,7 +166,9 @@ State share_of(State whole, std::shared_ptr<Exchange> exchange) {
   keep_grains(whole, share_indices(whole, *exchange));
   whole.neighbours = {};
   whole.wall_slots.clear();
-  whole.lost = exchange->rank() == 0 ? whole.lost : 0;  // counted once, summed over the ranks
+  // Counted once, summed over the ranks.
+  whole.lost = exchange->rank() == 0 ? whole.lost : 0;
+  whole.wall_work = exchange->rank() == 0 ? whole.wall_work : 0;
   whole.exchange = std::move(exchange);
   return whole;
 }
@@ -199,7 +201,8 @@ bool writes_outputs(const State& s) { return !s.exchange || s.exchange->rank() =
 
 State gathered(const State& s) {
   State whole;
-  whole.time = s.time, whole.step = s.step, whole.wall_work = s.wall_work;
+  whole.time = s.time, whole.step = s.step;
+  whole.wall_work = s.exchange ? s.exchange->sum(s.wall_work) : s.wall_work;
   whole.lost = s.exchange ? s.exchange->sum(s.lost) : s.lost;
   std::vector<char> mine;
   for (std::size_t i = 0; i < s.owned(); ++i) put(mine, grain_record(s, i));

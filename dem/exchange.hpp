@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <type_traits>
 #include <vector>
 
@@ -60,6 +61,21 @@ class Exchange {
   virtual double max(double local) = 0;
   virtual double sum(double local) = 0;
   virtual std::int64_t sum(std::int64_t local) = 0;
+  // Every rank's `local` values, rank after rank, on every rank.
+  virtual std::vector<double> all_gather(const std::vector<double>& local) = 0;
+  // The step's one collective (dem/step.cpp): every rank's `local` values, rank after rank, on
+  // every rank. The exchange sends its own beside them (the work its grains carry, weighed at the
+  // last build), so that the neighbour rebuild the values may call for makes no collective of its
+  // own unless it cuts the subdomains anew.
+  virtual std::vector<double> agree(const State& state, const std::vector<double>& local) = 0;
+  // Runs `work` on one rank after another in rank order (rank r starts when r - 1 is done), for an
+  // output that every rank appends its own part to. Point to point: no collective.
+  virtual void in_turn(const std::function<void()>& work) = 0;
+  // The collective calls over every rank made so far (MPI_COMM_WORLD's reductions, gathers,
+  // barriers, and an exchange with every rank), for the benchmarks.
+  virtual std::int64_t global_collectives() const = 0;
+  // How often the subdomains were cut, the first time included (a cut adds collectives of its own).
+  virtual std::int64_t cuts() const = 0;
   // Every rank's bytes, concatenated in rank order, on rank 0 (empty elsewhere).
   virtual std::vector<char> gather(const std::vector<char>& local) = 0;
   virtual void barrier() = 0;
@@ -74,8 +90,13 @@ class Exchange {
   virtual void reordered(const std::vector<std::int32_t>& new_index) = 0;
   // Every step without a rebuild: the ghosts' positions and velocities, from their owners.
   virtual void update_ghosts(State& state) = 0;
-  // What this rank sends in one update_ghosts [bytes].
+  // What this rank sends in one update_ghosts [bytes], and in how many messages.
   virtual std::size_t ghost_bytes_per_step() const = 0;
+  virtual std::size_t ghost_messages_per_step() const = 0;
+  // What the exchange knows between two rebuilds (its subdomains, whom it sends which ghosts), for
+  // a checkpoint resumed on the same rank count (dem/checkpoint.cpp): put, then restored as it was.
+  virtual std::vector<char> saved() const = 0;
+  virtual void restore(const char* bytes, std::size_t size) = 0;
 };
 
 }  // namespace dem

@@ -8,11 +8,13 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <numeric>
 #include <sstream>
 
 #include "core/atomic_file.hpp"
 #include "core/base64.hpp"
 #include "core/error.hpp"
+#include "dem/distributed.hpp"
 
 namespace dem {
 
@@ -95,25 +97,72 @@ State read_particles_csv(const fs::path& path, int material, double default_dens
   return s;
 }
 
-void write_particles_csv(const State& s, const fs::path& path) {
-  const bool clumps = s.bodies.size() > 0;
-  std::string out = clumps ? "id,x,y,z,vx,vy,vz,wx,wy,wz,radius,density,body,qw,qx,qy,qz\n"
-                           : "id,x,y,z,vx,vy,vz,wx,wy,wz,radius,density\n";
-  for (std::size_t i = 0; i < s.size(); ++i) {
+namespace {
+
+// A split state's clumps numbered over all ranks (each rank's after the ranks before it); a
+// single process's as they are.
+std::int64_t first_body_number(const State& s) {
+  if (!s.exchange) return 0;
+  const std::vector<double> counts = s.exchange->all_gather({double(s.bodies.size())});
+  return std::int64_t(std::accumulate(counts.begin(), counts.begin() + s.exchange->rank(), 0.0));
+}
+
+// The owned grains' rows, written to `out` in pieces of about a megabyte.
+// `clumps`: the body columns, which a split state writes on every rank when any rank holds a clump.
+void write_csv_rows(const State& s, std::ofstream& out, bool header, bool clumps, std::int64_t first_body) {
+  std::string text;
+  if (header)
+    text = clumps ? "id,x,y,z,vx,vy,vz,wx,wy,wz,radius,density,body,qw,qx,qy,qz\n" : "id,x,y,z,vx,vy,vz,wx,wy,wz,radius,density\n";
+  for (std::size_t i = 0; i < s.owned(); ++i) {
     const std::int32_t b = s.body[i];
     // A member's density is its grain's, whose mass is the body's.
     const double density = b >= 0 ? s.bodies.mass[std::size_t(b)] / s.bodies.volume[std::size_t(b)]
                                    : s.mass[i] / (4.0 / 3.0 * 3.14159265358979323846 * std::pow(s.radius[i], 3));
-    out += fmt::format("{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}",
-                       s.id[i], s.x[i].x(), s.x[i].y(), s.x[i].z(), s.v[i].x(), s.v[i].y(), s.v[i].z(), s.w[i].x(),
-                       s.w[i].y(), s.w[i].z(), s.radius[i], density);
+    text += fmt::format("{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}",
+                        s.id[i], s.x[i].x(), s.x[i].y(), s.x[i].z(), s.v[i].x(), s.v[i].y(), s.v[i].z(), s.w[i].x(),
+                        s.w[i].y(), s.w[i].z(), s.radius[i], density);
     if (clumps) {
       const Quat q = b >= 0 ? s.bodies.q[std::size_t(b)] : Quat::Identity();
-      out += fmt::format(",{},{:.17g},{:.17g},{:.17g},{:.17g}", b, q.w(), q.x(), q.y(), q.z());
+      text += fmt::format(",{},{:.17g},{:.17g},{:.17g},{:.17g}", b >= 0 ? first_body + b : -1, q.w(), q.x(), q.y(), q.z());
     }
-    out += '\n';
+    text += '\n';
+    if (text.size() > (1u << 20)) out << text, text.clear();
   }
-  diefill::write_file_atomic(path, out);
+  out << text;
+}
+
+void check_written(const std::ofstream& out, const fs::path& path) {
+  if (!out) throw InputError(path.string(), "", "cannot be written", "Check that the output folder is writable and the disk is not full");
+}
+
+}  // namespace
+
+// Split over ranks, the ranks append their rows in turn to one file (rank order, each rank's in
+// its own order), which rank 0 then moves into place: no rank holds another's grains.
+void write_particles_csv(const State& s, const fs::path& path) {
+  if (!s.exchange) {
+    diefill::PendingFile pending(path);
+    {
+      std::ofstream out(pending.path(), std::ios::binary);
+      write_csv_rows(s, out, true, s.bodies.size() > 0, 0);
+      check_written(out, path);
+    }
+    pending.commit();
+    return;
+  }
+  const std::int64_t first_body = first_body_number(s);
+  const bool clumps = s.exchange->sum(std::int64_t(s.bodies.size())) > 0;
+  const fs::path partial = fs::path(path).concat(".partial");
+  const bool first = s.exchange->rank() == 0;
+  run_and_agree(s.exchange.get(), true, [&] {
+    s.exchange->in_turn([&] {
+      if (first && path.has_parent_path()) fs::create_directories(path.parent_path());
+      std::ofstream out(partial, first ? std::ios::binary | std::ios::trunc : std::ios::binary | std::ios::app);
+      write_csv_rows(s, out, first, clumps, first_body);
+      check_written(out, path);
+    });
+  });
+  run_and_agree(s.exchange.get(), first, [&] { fs::rename(partial, path); });
 }
 
 TrajectoryWriter::TrajectoryWriter(const fs::path& path, bool append) {
@@ -139,60 +188,119 @@ namespace {
 
 static_assert(std::endian::native == std::endian::little, "the VTU's binary arrays are written as the machine holds them");
 
-// A binary DataArray: base64 of a UInt64 byte count and the little-endian values (VTK's XML
-// "binary" format): every value exact, with no text conversion either way. (Base64's 4/3 leaves
-// it only 12 % smaller than nine-digit ASCII, measured on the ring's final state.)
-template <typename T>
-void binary_array(std::string& out, const char* type, const std::string& name, int components, const std::vector<T>& values) {
-  std::vector<std::uint8_t> bytes(sizeof(std::uint64_t) + values.size() * sizeof(T));
-  const std::uint64_t size = values.size() * sizeof(T);
-  std::memcpy(bytes.data(), &size, sizeof size);
-  if (!values.empty()) std::memcpy(bytes.data() + sizeof size, values.data(), size);
+// Base64 of one stream of bytes fed in small pieces, encoded a few megabytes at a time.
+class Base64Writer {
+ public:
+  explicit Base64Writer(std::ostream& out) : out_(out) {}
+  void add(const void* data, std::size_t size) {
+    pending_.append(static_cast<const char*>(data), size);
+    if (pending_.size() >= (std::size_t(3) << 20)) flush(pending_.size() / 3 * 3);
+  }
+  void finish() { flush(pending_.size()); }
+
+ private:
+  void flush(std::size_t bytes) {  // a multiple of 3, or the end: the pieces' codes join as one
+    out_ << diefill::base64_encode(pending_.data(), bytes);
+    pending_.erase(0, bytes);
+  }
+  std::ostream& out_;
+  std::string pending_;
+};
+
+static_assert(sizeof(Vec3) == 3 * sizeof(double), "a Vec3 is written as its three doubles");
+
+// A binary DataArray of `count` values value(i): base64 of a UInt64 byte count and the
+// little-endian values (VTK's XML "binary" format): every value exact, with no text conversion
+// either way. (Base64's 4/3 leaves it only 12 % smaller than nine-digit ASCII, measured on the
+// ring's final state.)
+template <typename Value>
+void binary_array(std::ostream& out, const char* type, const std::string& name, int components, std::size_t count, Value value) {
+  using T = std::decay_t<decltype(value(std::size_t{0}))>;
+  const std::uint64_t size = count * sizeof(T);
   // Scalars without NumberOfComponents, as VTK writes them (readers such as meshio then give 1-D arrays).
   const std::string shape = components > 1 ? fmt::format(" NumberOfComponents=\"{}\"", components) : "";
-  out += fmt::format("<DataArray type=\"{}\" Name=\"{}\"{} format=\"binary\">\n", type, name, shape);
-  out += diefill::base64_encode(bytes.data(), bytes.size());
-  out += "\n</DataArray>\n";
+  out << fmt::format("<DataArray type=\"{}\" Name=\"{}\"{} format=\"binary\">\n", type, name, shape);
+  Base64Writer encoded(out);
+  encoded.add(&size, sizeof size);
+  for (std::size_t i = 0; i < count; ++i) {
+    const T v = value(i);
+    encoded.add(&v, sizeof v);
+  }
+  encoded.finish();
+  out << "\n</DataArray>\n";
 }
 
-std::vector<double> flattened(const Array<Vec3>& a) {
-  std::vector<double> out;
-  out.reserve(3 * a.size());
-  for (const Vec3& v : a) out.insert(out.end(), {v.x(), v.y(), v.z()});
-  return out;
+// The point data of write_vtu, in its order: name, VTK type, components.
+struct PointArray {
+  const char* name;
+  const char* type;
+  int components;
+};
+constexpr PointArray point_arrays[] = {{"id", "Int64", 1},       {"radius", "Float64", 1},           {"velocity", "Float64", 3},
+                                       {"angular_velocity", "Float64", 3}, {"force", "Float64", 3}, {"body", "Int64", 1}};
+
+// The owned grains as one VTU file.
+void write_vtu_file(const State& s, const fs::path& path) {
+  diefill::PendingFile pending(path);
+  {
+    std::ofstream out(pending.path(), std::ios::binary);
+    const std::size_t n = s.owned();
+    out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
+           "header_type=\"UInt64\">\n";
+    out << fmt::format("<UnstructuredGrid><Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n", n, n);
+    out << "<Points>\n";
+    binary_array(out, "Float64", "Points", 3, n, [&](std::size_t i) { return s.x[i]; });
+    out << "</Points>\n<PointData Scalars=\"radius\" Vectors=\"velocity\">\n";
+    binary_array(out, "Int64", "id", 1, n, [&](std::size_t i) { return s.id[i]; });
+    binary_array(out, "Float64", "radius", 1, n, [&](std::size_t i) { return s.radius[i]; });
+    binary_array(out, "Float64", "velocity", 3, n, [&](std::size_t i) { return s.v[i]; });
+    binary_array(out, "Float64", "angular_velocity", 3, n, [&](std::size_t i) { return s.w[i]; });
+    binary_array(out, "Float64", "force", 3, n, [&](std::size_t i) { return s.f[i]; });
+    // A sphere is its own body; a clump is named by its first member.
+    binary_array(out, "Int64", "body", 1, n, [&](std::size_t i) {
+      const std::int32_t b = s.body[i];
+      return s.id[b < 0 ? i : std::size_t(s.bodies.member[std::size_t(s.bodies.member_start[std::size_t(b)])])];
+    });
+    out << "</PointData>\n<Cells>\n";
+    binary_array(out, "Int64", "connectivity", 1, n, [](std::size_t i) { return std::int64_t(i); });
+    binary_array(out, "Int64", "offsets", 1, n, [](std::size_t i) { return std::int64_t(i + 1); });
+    binary_array(out, "UInt8", "types", 1, n, [](std::size_t) { return std::uint8_t(1); });  // VTK_VERTEX
+    out << "</Cells>\n</Piece></UnstructuredGrid>\n</VTKFile>\n";
+    check_written(out, path);
+  }
+  pending.commit();
+}
+
+// The index ParaView opens for a split state's pieces.
+std::string pvtu_index(const std::vector<std::string>& pieces) {
+  std::string out = "<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
+                    "header_type=\"UInt64\">\n<PUnstructuredGrid GhostLevel=\"0\">\n"
+                    "<PPoints><PDataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\"/></PPoints>\n"
+                    "<PPointData Scalars=\"radius\" Vectors=\"velocity\">\n";
+  for (const PointArray& a : point_arrays)
+    out += fmt::format("<PDataArray type=\"{}\" Name=\"{}\"{}/>\n", a.type, a.name,
+                       a.components > 1 ? fmt::format(" NumberOfComponents=\"{}\"", a.components) : "");
+  out += "</PPointData>\n";
+  for (const std::string& piece : pieces) out += fmt::format("<Piece Source=\"{}\"/>\n", piece);
+  return out + "</PUnstructuredGrid>\n</VTKFile>\n";
 }
 
 }  // namespace
 
-void write_vtu(const State& s, const fs::path& path) {
-  std::string out;
-  out += "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
-         "header_type=\"UInt64\">\n";
-  out += fmt::format("<UnstructuredGrid><Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n", s.size(), s.size());
-  out += "<Points>\n";
-  binary_array(out, "Float64", "Points", 3, flattened(s.x));
-  out += "</Points>\n<PointData Scalars=\"radius\" Vectors=\"velocity\">\n";
-  binary_array(out, "Int64", "id", 1, std::vector<std::int64_t>(s.id.begin(), s.id.end()));
-  binary_array(out, "Float64", "radius", 1, std::vector<double>(s.radius.begin(), s.radius.end()));
-  binary_array(out, "Float64", "velocity", 3, flattened(s.v));
-  binary_array(out, "Float64", "angular_velocity", 3, flattened(s.w));
-  binary_array(out, "Float64", "force", 3, flattened(s.f));
-  // A sphere is its own body; a clump is named by its first member.
-  std::vector<std::int64_t> body(s.size()), connectivity(s.size()), offsets(s.size());
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    const std::int32_t b = s.body[i];
-    const std::size_t named = b < 0 ? i : std::size_t(s.bodies.member[std::size_t(s.bodies.member_start[std::size_t(b)])]);
-    body[i] = s.id[named];
-    connectivity[i] = std::int64_t(i);
-    offsets[i] = std::int64_t(i + 1);
+fs::path write_vtu(const State& s, const fs::path& path) {
+  if (!s.exchange) {
+    write_vtu_file(s, path);
+    return path;
   }
-  binary_array(out, "Int64", "body", 1, body);
-  out += "</PointData>\n<Cells>\n";
-  binary_array(out, "Int64", "connectivity", 1, connectivity);
-  binary_array(out, "Int64", "offsets", 1, offsets);
-  binary_array(out, "UInt8", "types", 1, std::vector<std::uint8_t>(s.size(), 1));  // VTK_VERTEX
-  out += "</Cells>\n</Piece></UnstructuredGrid>\n</VTKFile>\n";
-  diefill::write_file_atomic(path, out);
+  const int rank = s.exchange->rank(), ranks = s.exchange->ranks();
+  const auto piece = [&](int r) { return fmt::format("{}_r{}.vtu", path.stem().string(), r); };
+  run_and_agree(s.exchange.get(), true, [&] { write_vtu_file(s, path.parent_path() / piece(rank)); });
+  fs::path index = path;
+  index.replace_extension(".pvtu");
+  std::vector<std::string> pieces;
+  for (int r = 0; r < ranks; ++r) pieces.push_back(piece(r));
+  run_and_agree(s.exchange.get(), rank == 0, [&] { diefill::write_file_atomic(index, pvtu_index(pieces)); });
+  return index;
 }
 
 }  // namespace dem

@@ -16,7 +16,8 @@ namespace dem {
 // the line and the column for missing columns, unparsable or non-finite values.
 State read_particles_csv(const std::filesystem::path& path, int material, double default_density);
 // Adds `body,qw,qx,qy,qz` (body index, its orientation; -1 and identity for a free sphere)
-// when the state holds clumps.
+// when the state holds clumps. Split over ranks (collective): one file of every rank's grains,
+// rank after rank.
 void write_particles_csv(const State& state, const std::filesystem::path& path);
 
 // Appends `t,id,x,y,z,vx,vy,vz,wx,wy,wz,fx,fy,fz` rows.
@@ -32,8 +33,10 @@ class TrajectoryWriter {
 };
 
 // VTK XML unstructured grid of points with point data id, radius, velocity, angular_velocity,
-// force, body.
-void write_vtu(const State& state, const std::filesystem::path& path);
+// force, body; returns what it wrote. Split over ranks (collective): every rank writes its owned
+// grains as a piece beside `path` (NAME_rR.vtu) and rank 0 the index ParaView opens, `path` with
+// the extension .pvtu.
+std::filesystem::path write_vtu(const State& state, const std::filesystem::path& path);
 
 }  // namespace dem
 

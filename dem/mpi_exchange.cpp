@@ -3,7 +3,9 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <exception>
 #include <limits>
+#include <stdexcept>
 
 #include "dem/distributed.hpp"
 #include "dem/model.hpp"
@@ -35,22 +37,30 @@ class MpiExchange final : public Exchange {
   double max(double local) override {
     double global = 0;
     MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    ++collectives_;
     return global;
   }
   double sum(double local) override {
-    std::vector<double> all(static_cast<std::size_t>(ranks_));
-    MPI_Allgather(&local, 1, MPI_DOUBLE, all.data(), 1, MPI_DOUBLE, MPI_COMM_WORLD);
     double total = 0;
-    for (double v : all) total += v;  // rank order: the same bits every run
+    for (double v : all_gather({local})) total += v;  // rank order: the same bits every run
     return total;
   }
   std::int64_t sum(std::int64_t local) override {
     std::int64_t global = 0;
     MPI_Allreduce(&local, &global, 1, MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD);
+    ++collectives_;
     return global;
   }
+  std::vector<double> all_gather(const std::vector<double>& local) override;
+  std::vector<double> agree(const State& s, const std::vector<double>& local) override;
+  void in_turn(const std::function<void()>& work) override;
+  std::int64_t global_collectives() const override { return collectives_ + cuts_.collectives(); }
+  std::int64_t cuts() const override { return cut_count_; }
   std::vector<char> gather(const std::vector<char>& local) override;
-  void barrier() override { MPI_Barrier(MPI_COMM_WORLD); }
+  void barrier() override {
+    MPI_Barrier(MPI_COMM_WORLD);
+    ++collectives_;
+  }
   void redistribute(const Model& model, State& s) override;
   void reordered(const std::vector<std::int32_t>& new_index) override {
     for (auto& list : send_)
@@ -62,6 +72,13 @@ class MpiExchange final : public Exchange {
     for (const auto& list : send_) grains += list.size();
     return grains * sizeof(GhostMotion);
   }
+  std::size_t ghost_messages_per_step() const override {
+    std::size_t messages = 0;
+    for (const auto& list : send_) messages += list.empty() ? 0 : 1;
+    return messages;
+  }
+  std::vector<char> saved() const override;
+  void restore(const char* bytes, std::size_t size) override;
 
  private:
   struct Outgoing {
@@ -73,12 +90,19 @@ class MpiExchange final : public Exchange {
   // counts bytes in int, which a gathered state or a migration can outgrow (a gather of 20 M
   // grains is over 2 GiB), and Open MPI 4.1 has no MPI_Count variants: the sizes travel as 64-bit
   // counts, the bytes in messages of at most largest_message_.
-  std::vector<char> transfer(const std::vector<Outgoing>& out, const std::vector<int>& from) const;
+  // `at`, when given, receives where each rank's bytes begin in the result (one more than `from`).
+  std::vector<char> transfer(const std::vector<Outgoing>& out, const std::vector<int>& from,
+                             std::vector<std::size_t>* at = nullptr);
+  // The bytes alone, when the receiver knows how many each rank of `from` sends (ascending offsets
+  // into the result, one more than `from`).
+  std::vector<char> move_bytes(const std::vector<Outgoing>& out, const std::vector<int>& from,
+                               const std::vector<std::size_t>& at) const;
+
   // Each rank's buffer to it; returns what every rank sent here, in rank order.
-  std::vector<char> all_to_all(const std::vector<std::vector<char>>& out) const;
+  std::vector<char> all_to_all(const std::vector<std::vector<char>>& out);
   // The same when only the neighbouring subdomains' buffers can hold anything: messages to and
   // from them alone, so that a step's cost does not grow with the number of ranks.
-  std::vector<char> with_neighbours(const std::vector<std::vector<char>>& out) const;
+  std::vector<char> with_neighbours(const std::vector<std::vector<char>>& out, std::vector<std::size_t>* at = nullptr);
   void migrate(State& s);
   void send_ghosts(const Model& model, State& s);
 
@@ -89,25 +113,120 @@ class MpiExchange final : public Exchange {
   // The other ranks whose boxes lie within ghost reach of this one's, ascending: the only ones a
   // ghost goes to or a grain migrates to between two cuts.
   std::vector<int> neighbours_;
+  // Where each neighbour's ghosts begin among this rank's (offsets in bytes of GhostMotion, one
+  // more than neighbours_): fixed from one rebuild to the next, so that a ghost update is one
+  // round of messages.
+  std::vector<std::size_t> ghost_at_;
+  std::vector<std::vector<char>> ghost_out_;  // [ranks] the update's buffers, kept from step to step
+  // The largest radius and member offset of all grains, and the ghost reach they give: the same
+  // from one cut to the next (grains come or go only with a cut, exchange.hpp).
+  double reach_ = 0, outside_ = 0;
+  bool recut_ = false;  // the last migrate cut anew
+  // From the step's agree(): the heaviest rank's work and the mean, for the rebuild it may call.
+  bool agreed_ = false;
+  double heaviest_ = 0, mean_ = 0;
+  std::int64_t collectives_ = 0, cut_count_ = 0;
 };
 
-std::vector<char> MpiExchange::transfer(const std::vector<Outgoing>& out, const std::vector<int>& from) const {
+// The work a rank's grains carry, as migrate weighs it: each active grain, and its listed pairs.
+double work_of(const State& s) {
+  const NeighbourList& nl = s.neighbours;
+  const bool listed = nl.row_start.size() == s.size() + 1;
+  std::int64_t work = 0;
+  for (std::size_t i = 0; i < s.owned(); ++i)
+    if (s.active[i]) work += 1 + (listed ? std::int64_t(nl.row_start[i + 1] - nl.row_start[i]) : 0);
+  return double(work);
+}
+
+std::vector<double> MpiExchange::all_gather(const std::vector<double>& local) {
+  std::vector<double> all(local.size() * std::size_t(ranks_));
+  MPI_Allgather(local.data(), int(local.size()), MPI_DOUBLE, all.data(), int(local.size()), MPI_DOUBLE, MPI_COMM_WORLD);
+  ++collectives_;
+  return all;
+}
+
+std::vector<double> MpiExchange::agree(const State& s, const std::vector<double>& local) {
+  std::vector<double> mine = local;
+  mine.push_back(work_of(s));
+  const std::vector<double> all = all_gather(mine);
+  const std::size_t k = mine.size();
+  std::vector<double> theirs;
+  theirs.reserve(local.size() * std::size_t(ranks_));
+  double total = 0;
+  heaviest_ = 0;
+  for (std::size_t r = 0; r < std::size_t(ranks_); ++r) {
+    theirs.insert(theirs.end(), all.begin() + std::ptrdiff_t(r * k), all.begin() + std::ptrdiff_t(r * k + k - 1));
+    heaviest_ = std::max(heaviest_, all[r * k + k - 1]), total += all[r * k + k - 1];
+  }
+  mean_ = total / ranks_;
+  agreed_ = true;
+  return theirs;
+}
+
+// The token is one byte; a failing rank passes it on before it rethrows, so that no rank waits
+// for ever.
+void MpiExchange::in_turn(const std::function<void()>& work) {
+  char token = 0;
+  if (rank_ > 0) MPI_Recv(&token, 1, MPI_CHAR, rank_ - 1, 2, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  std::exception_ptr failure;
+  try {
+    work();
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  if (rank_ + 1 < ranks_) MPI_Send(&token, 1, MPI_CHAR, rank_ + 1, 2, MPI_COMM_WORLD);
+  if (failure) std::rethrow_exception(failure);
+}
+
+std::vector<char> MpiExchange::saved() const {
+  std::vector<char> out;
+  cuts_.save(out);
+  put(out, std::uint64_t(neighbours_.size()));
+  for (std::size_t k = 0; k < neighbours_.size(); ++k) put(out, neighbours_[k]), put(out, std::uint64_t(ghost_at_[k + 1] - ghost_at_[k]));
+  for (const auto& list : send_) {
+    put(out, std::uint64_t(list.size()));
+    for (std::int32_t i : list) put(out, i);
+  }
+  put(out, reach_), put(out, outside_);
+  return out;
+}
+
+void MpiExchange::restore(const char* bytes, std::size_t size) {
+  const char* at = bytes;
+  cuts_.restore(at);
+  neighbours_.resize(take<std::uint64_t>(at));
+  ghost_at_.assign(neighbours_.size() + 1, 0);
+  for (std::size_t k = 0; k < neighbours_.size(); ++k) neighbours_[k] = take<int>(at), ghost_at_[k + 1] = ghost_at_[k] + take<std::uint64_t>(at);
+  send_.assign(std::size_t(ranks_), {});
+  for (auto& list : send_) {
+    list.resize(take<std::uint64_t>(at));
+    for (std::int32_t& i : list) i = take<std::int32_t>(at);
+  }
+  reach_ = take<double>(at), outside_ = take<double>(at);
+  if (at != bytes + size) throw std::logic_error("MpiExchange::restore: the saved exchange has another size");
+}
+
+std::vector<char> MpiExchange::transfer(const std::vector<Outgoing>& out, const std::vector<int>& from,
+                                        std::vector<std::size_t>* offsets) {
   std::vector<std::uint64_t> sizes(out.size()), receive_sizes(from.size());
   std::vector<MPI_Request> requests;
-  const auto wait = [&] {
-    MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
-    requests.clear();
-  };
   for (std::size_t k = 0; k < from.size(); ++k)
     MPI_Irecv(&receive_sizes[k], 1, MPI_UINT64_T, from[k], 0, MPI_COMM_WORLD, &requests.emplace_back());
   for (std::size_t k = 0; k < out.size(); ++k) {
     sizes[k] = out[k].bytes->size();
     MPI_Isend(&sizes[k], 1, MPI_UINT64_T, out[k].to, 0, MPI_COMM_WORLD, &requests.emplace_back());
   }
-  wait();
+  MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
   std::vector<std::size_t> at(from.size() + 1, 0);
   for (std::size_t k = 0; k < from.size(); ++k) at[k + 1] = at[k] + std::size_t(receive_sizes[k]);
+  if (offsets) *offsets = at;
+  return move_bytes(out, from, at);
+}
+
+std::vector<char> MpiExchange::move_bytes(const std::vector<Outgoing>& out, const std::vector<int>& from,
+                                          const std::vector<std::size_t>& at) const {
   std::vector<char> received(at.back());
+  std::vector<MPI_Request> requests;
   // Both sides cut a buffer alike, from its size; MPI keeps the order of the messages between two
   // ranks with one tag, so that the k-th piece sent meets the k-th receive.
   const auto piece = [&](std::size_t size, std::size_t offset) { return int(std::min(size - offset, largest_message_)); };
@@ -118,24 +237,26 @@ std::vector<char> MpiExchange::transfer(const std::vector<Outgoing>& out, const 
   for (const Outgoing& o : out)
     for (std::size_t b = 0; b < o.bytes->size(); b += largest_message_)
       MPI_Isend(o.bytes->data() + b, piece(o.bytes->size(), b), MPI_BYTE, o.to, 1, MPI_COMM_WORLD, &requests.emplace_back());
-  wait();
+  MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
   return received;
 }
 
-std::vector<char> MpiExchange::all_to_all(const std::vector<std::vector<char>>& out) const {
+std::vector<char> MpiExchange::all_to_all(const std::vector<std::vector<char>>& out) {
+  ++collectives_;  // point to point, but with every rank
   std::vector<Outgoing> sending;
   std::vector<int> every(static_cast<std::size_t>(ranks_));
   for (int r = 0; r < ranks_; ++r) sending.push_back({r, &out[std::size_t(r)]}), every[std::size_t(r)] = r;
   return transfer(sending, every);
 }
 
-std::vector<char> MpiExchange::with_neighbours(const std::vector<std::vector<char>>& out) const {
+std::vector<char> MpiExchange::with_neighbours(const std::vector<std::vector<char>>& out, std::vector<std::size_t>* at) {
   std::vector<Outgoing> sending;
   for (int r : neighbours_) sending.push_back({r, &out[std::size_t(r)]});
-  return transfer(sending, neighbours_);
+  return transfer(sending, neighbours_, at);
 }
 
 std::vector<char> MpiExchange::gather(const std::vector<char>& local) {
+  ++collectives_;
   std::vector<int> every;
   for (int r = 0; rank_ == 0 && r < ranks_; ++r) every.push_back(r);
   return transfer({{0, &local}}, every);
@@ -170,23 +291,27 @@ void MpiExchange::migrate(State& s) {
       points.push_back({B.x[b], weight});
     }
 
-  // Cut anew at the first call, or when the heaviest rank carries more than 1.2 times the mean.
-  double work = 0;
-  for (const WeightedPoint& p : points) work += double(p.weight);
-  const double heaviest = max(work), mean = sum(work) / ranks_;
-  // Also whenever the grains come without a list (shared anew, resumed, a round inserted): the
+  // Cut anew at the first call, or when the heaviest rank carries more than 1.2 times the mean
+  // (weighed by the step's agree(), or here when no step came before: initialize()). Also whenever
+  // the grains come without a list (shared anew, resumed, a round inserted; every rank alike): the
   // cuts then follow from the grains alone, not from what the exchange did before.
-  const bool recut = cuts_.empty() || !listed || heaviest > 1.2 * mean;
-  if (recut) cuts_.cut(points);
+  if (!agreed_) {
+    const std::vector<double> work = all_gather({work_of(s)});
+    heaviest_ = *std::max_element(work.begin(), work.end());
+    mean_ = 0;
+    for (double w : work) mean_ += w / ranks_;
+  }
+  agreed_ = false;
+  recut_ = cuts_.empty() || !listed || heaviest_ > 1.2 * mean_;
+  if (recut_) cuts_.cut(points), ++cut_count_;
 
   std::vector<std::vector<char>> out(static_cast<std::size_t>(ranks_));
   std::vector<std::size_t> keep;
   Array<std::int32_t> near;
   Array<WallSlot> slots;
   std::vector<CarriedPair> carried;
-  // Between two cuts a grain moves less than the ghost reach between rebuilds, so it migrates to a
-  // neighbour; after a cut, or should one not, every rank may send to every other.
-  bool beyond_neighbours = recut;
+  // Between two cuts a grain moves less than half the skin between rebuilds, less than the ghost
+  // reach, so it migrates to a neighbour; after a cut every rank may send to every other.
   const auto stay = [&](std::size_t i) {
     keep.push_back(i);
     if (slots_of[i]) {
@@ -204,7 +329,8 @@ void MpiExchange::migrate(State& s) {
   // A unit's destination; a lost grain stays where it was lost: it takes part in nothing.
   const auto destination = [&](bool active, const Vec3& x) {
     const int to = active ? cuts_.owner(x) : rank_;
-    if (to != rank_ && !std::binary_search(neighbours_.begin(), neighbours_.end(), to)) beyond_neighbours = true;
+    if (!recut_ && to != rank_ && !std::binary_search(neighbours_.begin(), neighbours_.end(), to))
+      throw std::logic_error("migrate: a grain moved beyond the neighbouring subdomains between two rebuilds");
     return to;
   };
   // Each unit in the buffer: its member count (0: a free grain), for a clump its body and offsets,
@@ -232,7 +358,7 @@ void MpiExchange::migrate(State& s) {
     for (std::int32_t k = first; k < last; ++k) put(buffer, B.offset[std::size_t(k)]);
     for (std::int32_t k = first; k < last; ++k) send(buffer, std::size_t(B.member[std::size_t(k)]));
   }
-  const std::vector<char> received = max(beyond_neighbours ? 1.0 : 0.0) > 0 ? all_to_all(out) : with_neighbours(out);
+  const std::vector<char> received = recut_ ? all_to_all(out) : with_neighbours(out);
   keep_grains(s, keep);
   const auto arrive = [&](const char*& at) {
     const Migrant m = take<Migrant>(at);
@@ -267,41 +393,50 @@ void MpiExchange::migrate(State& s) {
 // skin, the farthest a listed partner of a grain inside that subdomain can be at the build, and
 // with clumps the farthest a member lies from its body's centre, which alone lies in the box.
 void MpiExchange::send_ghosts(const Model& model, State& s) {
-  double r_max = 0, outside = 0;
-  for (std::size_t i = 0; i < s.size(); ++i) r_max = std::max(r_max, s.radius[i]);
-  const Bodies& B = s.bodies;
-  for (std::size_t b = 0; b < B.size(); ++b)
-    for (std::int32_t k = B.member_start[b]; k < B.member_start[b + 1]; ++k)
-      outside = std::max(outside, (s.x[std::size_t(B.member[std::size_t(k)])] - B.x[b]).norm());
-  outside = max(outside);
-  const double reach = 2 * max(r_max) + model.skin + outside;
+  if (recut_) {
+    double r_max = 0, outside = 0;
+    for (std::size_t i = 0; i < s.size(); ++i) r_max = std::max(r_max, s.radius[i]);
+    const Bodies& B = s.bodies;
+    for (std::size_t b = 0; b < B.size(); ++b)
+      for (std::int32_t k = B.member_start[b]; k < B.member_start[b + 1]; ++k)
+        outside = std::max(outside, (s.x[std::size_t(B.member[std::size_t(k)])] - B.x[b]).norm());
+    outside_ = max(outside);
+    reach_ = 2 * max(r_max) + model.skin + outside_;
+  }
   // The owned grains lie in this rank's box, or as far outside it as a member from its centre:
   // only boxes within reach of that can want them.
   neighbours_.clear();
   const std::vector<Box>& boxes = cuts_.boxes();
   for (int r = 0; r < ranks_; ++r)
-    if (r != rank_ && boxes[std::size_t(r)].distance(boxes[std::size_t(rank_)]) < reach + outside) neighbours_.push_back(r);
+    if (r != rank_ && boxes[std::size_t(r)].distance(boxes[std::size_t(rank_)]) < reach_ + outside_) neighbours_.push_back(r);
   send_.assign(std::size_t(ranks_), {});
   std::vector<std::vector<char>> out(static_cast<std::size_t>(ranks_));
   for (std::size_t i = 0; i < s.size(); ++i) {
     if (!s.active[i]) continue;
     for (int r : neighbours_)
-      if (boxes[std::size_t(r)].distance(s.x[i]) < reach) {
+      if (boxes[std::size_t(r)].distance(s.x[i]) < reach_) {
         send_[std::size_t(r)].push_back(std::int32_t(i));
         put(out[std::size_t(r)], grain_record(s, i));
       }
   }
-  const std::vector<char> received = with_neighbours(out);
+  const std::vector<char> received = with_neighbours(out, &ghost_at_);
+  for (std::size_t& at : ghost_at_) at = at / sizeof(GrainRecord) * sizeof(GhostMotion);
   for (const char* at = received.data(); at < received.data() + received.size(); ++s.ghosts) {
     append_grain(s, take<GrainRecord>(at));
   }
 }
 
+// One round of messages: each neighbour sends as many ghosts as at the rebuild, in the same order.
 void MpiExchange::update_ghosts(State& s) {
-  std::vector<std::vector<char>> out(static_cast<std::size_t>(ranks_));
-  for (std::size_t r = 0; r < send_.size(); ++r)
-    for (std::int32_t i : send_[r]) put(out[r], GhostMotion{s.x[std::size_t(i)], s.v[std::size_t(i)], s.w[std::size_t(i)]});
-  const std::vector<char> received = with_neighbours(out);
+  ghost_out_.resize(std::size_t(ranks_));
+  std::vector<Outgoing> sending;
+  for (int r : neighbours_) {
+    std::vector<char>& buffer = ghost_out_[std::size_t(r)];
+    buffer.clear();
+    for (std::int32_t i : send_[std::size_t(r)]) put(buffer, GhostMotion{s.x[std::size_t(i)], s.v[std::size_t(i)], s.w[std::size_t(i)]});
+    sending.push_back({r, &buffer});
+  }
+  const std::vector<char> received = move_bytes(sending, neighbours_, ghost_at_);
   std::size_t g = s.owned();
   for (const char* at = received.data(); at < received.data() + received.size(); ++g) {
     const GhostMotion m = take<GhostMotion>(at);

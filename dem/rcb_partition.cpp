@@ -1,5 +1,7 @@
 #include "dem/rcb_partition.hpp"
 
+#include "dem/exchange.hpp"
+
 #include <mpi.h>
 
 #include <algorithm>
@@ -40,6 +42,7 @@ void RcbPartition::cut(const std::vector<WeightedPoint>& local) {
     }
     MPI_Allreduce(MPI_IN_PLACE, extent.data(), int(6 * m), MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
     MPI_Allreduce(MPI_IN_PLACE, total.data(), int(m), MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD);
+    collectives_ += 2;
     std::vector<int> axis(m, 0);
     std::vector<double> low(m), high(m);  // the bisection's interval
     for (std::size_t n = 0; n < m; ++n) {
@@ -56,6 +59,7 @@ void RcbPartition::cut(const std::vector<WeightedPoint>& local) {
         if (const int n = node_of[k]; n >= 0 && local[k].x[axis[std::size_t(n)]] < 0.5 * (low[std::size_t(n)] + high[std::size_t(n)]))
           below[std::size_t(n)] += local[k].weight;
       MPI_Allreduce(MPI_IN_PLACE, below.data(), int(m), MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD);
+      ++collectives_;
       for (std::size_t n = 0; n < m; ++n) {
         const Node& node = level[n];
         const int mid = node.lo + (node.hi - node.lo) / 2;
@@ -93,6 +97,21 @@ void RcbPartition::cut(const std::vector<WeightedPoint>& local) {
         node_of[k] = child[2 * std::size_t(n) + (local[k].x[axis[std::size_t(n)]] < high[std::size_t(n)] ? 0 : 1)];
     level.swap(next);
   }
+}
+
+void RcbPartition::save(std::vector<char>& out) const {
+  put(out, std::uint64_t(cuts_.size()));
+  for (const Cut& c : cuts_) put(out, c.axis), put(out, c.at), put(out, c.below), put(out, c.above), put(out, c.rank);
+  put(out, std::uint64_t(boxes_.size()));
+  for (const Box& b : boxes_) put(out, b.lo), put(out, b.hi);
+}
+
+void RcbPartition::restore(const char*& at) {
+  cuts_.resize(take<std::uint64_t>(at));
+  for (Cut& c : cuts_)
+    c.axis = take<int>(at), c.at = take<double>(at), c.below = take<int>(at), c.above = take<int>(at), c.rank = take<int>(at);
+  boxes_.resize(take<std::uint64_t>(at));
+  for (Box& b : boxes_) b.lo = take<Vec3>(at), b.hi = take<Vec3>(at);
 }
 
 }  // namespace dem

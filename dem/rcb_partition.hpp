@@ -40,6 +40,12 @@ class RcbPartition {
   }
   // [ranks] they tile all of space.
   const std::vector<Box>& boxes() const { return boxes_; }
+  // The collective calls cut() made so far (the benchmarks count every one).
+  std::int64_t collectives() const { return collectives_; }
+  // The cuts as bytes, field by field (no padding), and back: a checkpoint resumed on the same
+  // rank count goes on with the cuts it had.
+  void save(std::vector<char>& out) const;
+  void restore(const char*& at);
 
  private:
   // A tree of cuts, each leaf a rank.
@@ -50,6 +56,7 @@ class RcbPartition {
   };
   std::vector<Cut> cuts_;
   std::vector<Box> boxes_;
+  std::int64_t collectives_ = 0;
 };
 
 }  // namespace dem

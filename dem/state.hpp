@@ -19,6 +19,7 @@ inline constexpr int wall_slots_per_particle = 4;  // K: contacts one grain keep
 
 struct WallSlot {
   std::int32_t wall = -1;  // planes first, then mesh walls; -1: empty
+  std::int32_t unused = 0;  // the padding, named: a checkpoint writes slots as bytes, the same state the same bytes
   Vec3 normal = Vec3::Zero();  // last contact normal, to recognise the contact next step
   ContactHistory history;
 };
@@ -106,6 +107,11 @@ struct StepCounters {
   // At the last energy check (every few hundred steps): the mechanical energy beyond what gravity
   // and the walls can have given, over the energy scale Σ m g r; negative while energy is lost.
   double energy_gain = 0;
+  // A step checks the step before it, with the values every rank sent to its one collective
+  // (dem/step.cpp): the largest δ/R of that step over the ranks, and whether any rank was asked
+  // to stop (stop_asked, set by the caller before the step) so that all stop after the same step.
+  double checked_overlap_rel = 0;
+  bool stop_asked = false, stop_agreed = false;
 };
 
 struct State {
@@ -142,7 +148,7 @@ struct State {
   double time = 0;              // [s]
   std::int64_t step = 0;
   std::int64_t lost = 0;        // particles that left the domain
-  double wall_work = 0;         // energy walls delivered to particles so far [J]
+  double wall_work = 0;         // energy walls delivered to this rank's particles so far [J]
   double energy_reference = 0;  // mechanical energy at initialize() [J]
   double energy_scale = 0;      // Σ m g r: the energy of a grain-radius drop of every grain [J]
   bool energy_reference_set = false;

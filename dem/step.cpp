@@ -3,6 +3,8 @@
 #include <fmt/core.h>
 
 #include <cmath>
+#include <limits>
+#include <vector>
 
 #include "core/sha256.hpp"
 #include "core/timer.hpp"
@@ -16,15 +18,17 @@ namespace dem {
 namespace {
 
 // The first half of velocity Verlet in one pass: free grains kicked by half a step and moved a
-// step (clump members were placed by their bodies already), and the largest displacement of any
-// grain since the neighbour list was built, which decides whether to rebuild it.
+// step (clump members were placed by their bodies already), and the largest displacement of this
+// rank's grains since the neighbour list was built, which decides (over all ranks) whether to
+// rebuild it.
 double kick_and_drift(State& s, double half_dt, double dt) {
   kick_bodies(s, half_dt);
   drift_bodies(s, dt);
   const std::size_t n = s.owned();
   const Array<Vec3>& built = s.neighbours.x_at_build;
   const bool listed = built.size() == s.size();
-  double largest = 0;
+  // No list (a state read back or shared anew): every rank rebuilds, one holding no grain too.
+  double largest = listed ? 0 : std::numeric_limits<double>::infinity();
 #pragma omp parallel for schedule(static) reduction(max : largest)
   for (std::size_t i = 0; i < n; ++i) {
     if (!s.active[i]) continue;
@@ -35,7 +39,7 @@ double kick_and_drift(State& s, double half_dt, double dt) {
     }
     if (listed) largest = std::max(largest, (s.x[i] - built[i]).squaredNorm());
   }
-  return s.exchange ? s.exchange->max(largest) : largest;
+  return largest;
 }
 
 // Forces on every grain; with kick_dt > 0 the second half kick of velocity Verlet follows in
@@ -93,50 +97,90 @@ std::string worst_overlap(const Model& model, const State& s) {
 // Mechanical energy may only grow by what walls deliver; checked every `energy_interval` steps.
 constexpr int energy_interval = 200;
 
-// The sum or the largest value over the ranks (the local one on a single process).
-double global_sum(const State& s, double local) { return s.exchange ? s.exchange->sum(local) : local; }
-double global_max(const State& s, double local) { return s.exchange ? s.exchange->max(local) : local; }
+// What the checks of a step need from every rank. A split run makes one collective per step
+// (docs/ARCHITECTURE.md, "Domain decomposition"): after the drift, every rank sends these
+// values of its own and receives everyone's (Exchange::agree). The rebuild test needs the drift's
+// displacement at once; the checks of the state the step started from (the last step's overlaps,
+// every `energy_interval` steps its energy) ride along, so that a failed check is reported one
+// step after the step that failed it.
+enum Signal : std::size_t { shift2, overlap, diverged, energy, wall_work, stop_asked, signal_count };
 
-StepReport monitor(const Model& model, State& s) {
+struct Agreed {
+  double shift2 = 0, overlap = 0, diverged = -1, energy = 0, wall_work = 0;
+  bool stop_asked = false;
+};
+
+// The signals of the state as it stands (the end of the last step), the displacement left at 0.
+std::vector<double> local_signals(const Model& model, const State& s, bool energy_due) {
+  std::vector<double> local(signal_count, 0.0);
+  local[overlap] = s.counters.max_overlap_rel;
+  local[diverged] = -1;
+  if (energy_due) {
+    for (std::size_t i = 0; i < s.owned() && local[diverged] < 0; ++i)
+      if (s.active[i] && !(s.x[i].allFinite() && s.v[i].allFinite() && s.w[i].allFinite())) local[diverged] = double(s.id[i]);
+    local[energy] = kinetic_energy(s) + potential_energy(model, s) + elastic_energy(model, s);
+  }
+  local[wall_work] = s.wall_work;
+  local[stop_asked] = s.counters.stop_asked ? 1 : 0;
+  return local;
+}
+
+// Largest values and sums in rank order over the ranks (the local ones on a single process).
+Agreed agree(State& s, const std::vector<double>& local) {
+  const std::vector<double> all = s.exchange ? s.exchange->agree(s, local) : local;
+  Agreed g;
+  for (std::size_t at = 0; at < all.size(); at += signal_count) {
+    g.shift2 = std::max(g.shift2, all[at + shift2]), g.overlap = std::max(g.overlap, all[at + overlap]);
+    g.diverged = std::max(g.diverged, all[at + diverged]);
+    g.energy += all[at + energy], g.wall_work += all[at + wall_work];
+    g.stop_asked = g.stop_asked || all[at + stop_asked] > 0;
+  }
+  return g;
+}
+
+// The checks of the state at `time` (step `step`), from the agreed values.
+StepReport check(const Model& model, State& s, const Agreed& g, bool energy_due, double time) {
   StepReport r;
-  s.wall_work += global_sum(s, s.counters.wall_power) * model.dt;
-  s.counters.max_overlap_rel = global_max(s, s.counters.max_overlap_rel);
-  if (s.counters.max_overlap_rel > model.stop_overlap) {
+  s.counters.checked_overlap_rel = g.overlap;
+  s.counters.stop_agreed = g.stop_asked;
+  if (g.overlap > model.stop_overlap) {
     r.status = StepStatus::overlap;
     r.message = fmt::format(
         "a contact overlap reached {:.3g} of the grain radius (limit {:.3g}) at t = {:.6g} s, between {}: "
         "the time step {:.3g} s is too large for the stiffness or the impact speed, or a moving wall "
         "pinches grains. Lower simulation.time_step (or its fraction), soften the material, or slow the walls",
-        s.counters.max_overlap_rel, model.stop_overlap, s.time, worst_overlap(model, s), model.dt);
+        g.overlap, model.stop_overlap, time, worst_overlap(model, s), model.dt);
     return r;
   }
-  if (s.step % energy_interval != 0) return r;
-  std::int64_t diverged = -1;
-  for (std::size_t i = 0; i < s.owned() && diverged < 0; ++i)
-    if (s.active[i] && !(s.x[i].allFinite() && s.v[i].allFinite() && s.w[i].allFinite())) diverged = s.id[i];
-  if (global_max(s, double(diverged)) >= 0) {
+  if (!energy_due) return r;
+  if (g.diverged >= 0) {
     r.status = StepStatus::non_finite;
     r.message = fmt::format("grain {} has a non-finite position or velocity at t = {:.6g} s: the "
                             "integration diverged. Lower simulation.time_step",
-                            std::int64_t(global_max(s, double(diverged))), s.time);
+                            std::int64_t(g.diverged), time);
     return r;
   }
-  const double energy = global_sum(s, kinetic_energy(s) + potential_energy(model, s) + elastic_energy(model, s));
   if (s.energy_reference_set) {
-    const double budget = s.energy_reference + s.wall_work;
-    s.counters.energy_gain = (energy - budget) / std::max(s.energy_scale, 1e-300);
+    const double budget = s.energy_reference + g.wall_work;
+    s.counters.energy_gain = (g.energy - budget) / std::max(s.energy_scale, 1e-300);
     const double slack = 1e-3 * std::abs(s.energy_reference) + 1e-3 * s.energy_scale + 1e-12;
-    if (energy > budget + slack) {
+    if (g.energy > budget + slack) {
       r.status = StepStatus::energy_growth;
       r.message = fmt::format(
           "the grains' energy grew to {:.4g} J, beyond the {:.4g} J gravity and the walls can "
           "have given them, at t = {:.6g} s: the time step {:.3g} s is unstable. Lower "
           "simulation.time_step",
-          energy, budget, s.time, model.dt);
+          g.energy, budget, time, model.dt);
     }
   }
   return r;
 }
+
+// The energy is checked at the end of every energy_interval-th step.
+bool energy_due(const State& s) { return s.step > 0 && s.step % energy_interval == 0; }
+
+// The sum over the ranks (the local one on a single process), outside the stepping loop.
+double global_sum(const State& s, double local) { return s.exchange ? s.exchange->sum(local) : local; }
 
 }  // namespace
 
@@ -175,11 +219,15 @@ void initialize(const Model& model, State& s) {
 
 StepReport step(const Model& model, State& s, StageTimes* times) {
   diefill::Stopwatch clock;
-  const double largest_shift2 = kick_and_drift(s, 0.5 * model.dt, model.dt);
+  const bool due = energy_due(s);
+  const double checked_time = s.time;
+  std::vector<double> local = local_signals(model, s, due);
+  local[shift2] = kick_and_drift(s, 0.5 * model.dt, model.dt);
   s.time += model.dt;
   ++s.step;
+  const Agreed agreed = agree(s, local);
   if (times) times->integration += clock.seconds(), clock.restart();
-  if (needs_rebuild(model, s, largest_shift2)) {
+  if (needs_rebuild(model, s, agreed.shift2)) {
     if (s.exchange) s.exchange->redistribute(model, s);
     rebuild_neighbours(model, s);
   } else if (s.exchange) {
@@ -188,9 +236,15 @@ StepReport step(const Model& model, State& s, StageTimes* times) {
   if (times) times->neighbours += clock.seconds(), clock.restart();
   forces(model, s, times, 0.5 * model.dt);
   clock.restart();
-  StepReport report = monitor(model, s);
+  s.wall_work += s.counters.wall_power * model.dt;  // this rank's; summed over the ranks when checked
+  StepReport report = check(model, s, agreed, due, checked_time);
   if (times) times->monitor += clock.seconds();
   return report;
+}
+
+StepReport check_last_step(const Model& model, State& s) {
+  const bool due = energy_due(s);
+  return check(model, s, agree(s, local_signals(model, s, due)), due, s.time);
 }
 
 std::string state_hash(const State& s) {

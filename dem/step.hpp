@@ -1,7 +1,8 @@
 #pragma once
 // One time step, as a table of contents of its stages (each timed):
-//   kick (half) and drift -> neighbour update (when needed) -> grain-grain forces ->
-//   grain-wall forces -> sums with the second half kick -> body sums and kick (clumps) -> monitor
+//   the last step's checks, kick (half) and drift -> the ranks agree (one collective) ->
+//   neighbour update (when needed) -> grain-grain forces -> grain-wall forces -> sums with the
+//   second half kick -> body sums and kick (clumps) -> the checks' verdict
 // ("sums" times the last pass over the grains, kick included).
 // Velocity Verlet: second order and symplectic for conservative forces; clumps rotate by the
 // splitting in bodies.hpp.
@@ -25,8 +26,13 @@ struct StepReport {
 
 // Neighbour list and forces for the current positions; call once before stepping.
 void initialize(const Model& model, State& state);
-// Advances one step. Nothing throws inside the loop: a failed check returns its status.
+// Advances one step. Nothing throws inside the loop: a failed check returns its status. A step
+// checks the state it started from (the step before's overlaps, and its energy every few hundred
+// steps) with the one collective it makes when split, so that a failure is reported one step late.
 StepReport step(const Model& model, State& state, StageTimes* times = nullptr);
+// The checks of the last step taken, which the next step would make: for the end of a run.
+// Collective when split.
+StepReport check_last_step(const Model& model, State& state);
 
 // Energy budget for the monitor [J].
 double kinetic_energy(const State& state);

@@ -26,11 +26,16 @@ void on_interrupt(int) {
   for (int signal : stop_signals) std::signal(signal, SIG_DFL);
 }
 
-// Split over ranks, Ctrl-C reaches the ranks at different steps: they agree every 64 steps, so
-// that all stop at the same one and write one checkpoint together.
-bool interrupted(const dem::State& s, std::int64_t steps) {
-  if (!s.exchange) return g_interrupted;
-  return (steps & 63) == 0 && s.exchange->max(g_interrupted ? 1.0 : 0.0) > 0;
+// A failed check stops the run, with a checkpoint to look at where the run keeps one.
+[[noreturn]] void stop_unstable(const dem::Model& model, dem::State& s, const LoopOptions& o, const dem::StepReport& report) {
+  if (!o.checkpoint.empty()) dem::write_checkpoint(model, s, o.checkpoint);
+  throw diefill::StabilityError(report.message + (o.checkpoint.empty() ? "" : fmt::format(" (checkpoint: {})", o.checkpoint.string())),
+                                model.dt);
+}
+
+void track_checks(dem::State& s) {
+  s.loop_max_overlap_rel = std::max(s.loop_max_overlap_rel, s.counters.checked_overlap_rel);
+  s.loop_max_energy_gain = std::max(s.loop_max_energy_gain, s.counters.energy_gain);
 }
 }  // namespace
 
@@ -69,17 +74,14 @@ LoopResult run_until(const dem::Model& model, dem::State& s, const LoopOptions& 
       result.finished_early = true;
       break;
     }
+    // Split over ranks, Ctrl-C reaches the ranks at different steps: the step makes them agree, so
+    // that all stop after the same one and write one checkpoint together.
+    s.counters.stop_asked = g_interrupted;
     const dem::StepReport report = dem::step(model, s, &result.times);
     ++result.steps;
-    s.loop_max_overlap_rel = std::max(s.loop_max_overlap_rel, s.counters.max_overlap_rel);
-    s.loop_max_energy_gain = std::max(s.loop_max_energy_gain, s.counters.energy_gain);
-    if (report.status != dem::StepStatus::ok) {
-      if (!o.checkpoint.empty()) dem::write_checkpoint(model, s, o.checkpoint);
-      throw diefill::StabilityError(report.message +
-                                    (o.checkpoint.empty() ? "" : fmt::format(" (checkpoint: {})", o.checkpoint.string())),
-                                    model.dt);
-    }
-    if (interrupted(s, result.steps)) {
+    track_checks(s);
+    if (report.status != dem::StepStatus::ok) stop_unstable(model, s, o, report);
+    if (s.counters.stop_agreed) {
       if (!o.checkpoint.empty()) dem::write_checkpoint(model, s, o.checkpoint);
       result.interrupted = true;
       break;
@@ -90,6 +92,8 @@ LoopResult run_until(const dem::Model& model, dem::State& s, const LoopOptions& 
                                                   o.detail ? ", " + o.detail(s) : std::string()));
     }
   }
+  if (const dem::StepReport last = dem::check_last_step(model, s); last.status != dem::StepStatus::ok) stop_unstable(model, s, o, last);
+  track_checks(s);
   if (!result.interrupted && !result.finished_early)
     for (const Periodic& p : o.outputs) p.action(s);
   result.max_overlap_rel = s.loop_max_overlap_rel, result.max_energy_gain = s.loop_max_energy_gain;

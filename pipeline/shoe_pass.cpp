@@ -152,7 +152,7 @@ std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& wal
     return std::nullopt;
   }
   if (!snapshot_times.empty() && dem::writes_outputs(state)) write_series(walls.die.solid, snapshot_times, dir);
-  if (dem::writes_outputs(state)) fs::remove(checkpoint), fs::remove(outputs_file(checkpoint));
+  if (dem::writes_outputs(state)) dem::remove_checkpoint(checkpoint), fs::remove(outputs_file(checkpoint));
   // The outputs are written from the whole state, on rank 0 of a split run.
   if (state.exchange) state = dem::gathered(state);
   return fill;

@@ -1,7 +1,8 @@
-// The DEM split over MPI ranks (dem/mpi_exchange.hpp), run by CTest under mpirun on 1 to 4
+// The DEM split over MPI ranks (dem/mpi_exchange.hpp), run by CTest under mpirun on 1 to 4 and 8
 // ranks: against the same scene run whole on every rank (the reference), forces and motion agree
 // to rounding; no grain is lost or doubled at any step; momentum is conserved in free flight;
 // the same rank count gives the same bits.
+#include <fmt/core.h>
 #include <gtest/gtest.h>
 #include <mpi.h>
 
@@ -236,7 +237,7 @@ void expect_bodies_match(const dem::State& part, const dem::State& whole, const 
 }
 
 // Checkpoints of the split runs, one per rank count, where CTest keeps them
-// (tests/CMakeLists.txt runs 1, 2, 3 and 4 ranks in that order).
+// (tests/CMakeLists.txt runs 1, 2, 3, 4 and 8 ranks in that order).
 std::filesystem::path checkpoint_of(int ranks) {
   const char* dir = std::getenv("DIEFILL_MPI_CHECKPOINTS");
   return std::filesystem::path(dir ? dir : "mpi_checkpoints") / ("lattice-" + std::to_string(ranks) + "-ranks");
@@ -260,17 +261,24 @@ TEST(MpiSplit, ForcesAndMotionMatchTheWholeSceneAndNoGrainIsLostOrDoubled) {
   if (world_size() > 1) EXPECT_GT(part.ghosts, 100u);
   else EXPECT_EQ(part.ghosts, 0u);
   expect_matches(part, whole, "after initialize");
-  std::int64_t rebuilds_while_matched = 0, contacts = 0;
+  std::int64_t rebuilds_while_matched = 0, contacts = 0, rebuilds = 0, cuts = 0;
+  dem::Exchange& exchange = *part.exchange;
   for (int n = 1; n <= 400; ++n) {
     dem::step(model, whole);
-    const std::int64_t before = part.neighbours.builds;
+    const std::int64_t before = part.neighbours.builds, collectives = exchange.global_collectives(), cut = exchange.cuts();
     dem::step(model, part);
     if (n <= 60) rebuilds_while_matched += part.neighbours.builds - before;
+    rebuilds += part.neighbours.builds - before, cuts += exchange.cuts() - cut;
+    // One collective a step, a rebuild's included, unless the step cut the subdomains anew.
+    if (exchange.cuts() == cut) {
+      EXPECT_EQ(exchange.global_collectives() - collectives, 1) << "at step " << n;
+    }
     contacts += part.exchange->sum(part.counters.contacts);
     if (n == 1 || n == 20 || n == 40 || n == 60) expect_matches(part, whole, ("after " + std::to_string(n) + " steps").c_str());
     if (n % 100 == 0) expect_every_grain_once(part, whole.size());
   }
   EXPECT_GE(rebuilds_while_matched, 1) << "grains migrated while the runs are compared";
+  EXPECT_GT(rebuilds, cuts) << "rebuilds without a cut were counted";
   EXPECT_GT(contacts, 100000);
 }
 
@@ -562,11 +570,12 @@ TEST(MpiSplit, TheSameRankCountGivesTheSameBits) {
   EXPECT_EQ(run(), run());
 }
 
-// A split run checkpointed at step 200 and resumed, by this rank count and by a run on one rank
-// fewer (CTest ran it just before): one step after the restart every grain's force is the
-// uninterrupted run's within 1e-12 of the largest (positions, forces and every pair's and wall
-// contact's history came back: a lost spring would change its grains' forces by its full size),
-// and 200 steps after it the kinetic energy and the mean height are the uninterrupted run's to 1e-9.
+// A split run checkpointed at step 200 and resumed, by this rank count and by a run on another
+// (one rank fewer, or DIEFILL_MPI_RESUME_FROM's; CTest ran it before): one step after the restart
+// every grain's force is the uninterrupted run's within 1e-12 of the largest (positions, forces
+// and every pair's and wall contact's history came back: a lost spring would change its grains'
+// forces by its full size), and 200 steps after it the kinetic energy and the mean height are the
+// uninterrupted run's to 1e-9; on its own rank count, the state is the uninterrupted run's, bit for bit.
 TEST(MpiCheckpoint, AnyRankCountResumesWithTheSameForcesAndStatistics) {
   const dem::ModelSpec spec = box_spec(true);
   dem::State whole = compressed_lattice(18, 0.3);
@@ -589,7 +598,9 @@ TEST(MpiCheckpoint, AnyRankCountResumesWithTheSameForcesAndStatistics) {
   }
   MPI_Barrier(MPI_COMM_WORLD);
 
-  for (const int writer : {world_size(), world_size() - 1}) {
+  // Another rank count's checkpoint: DIEFILL_MPI_RESUME_FROM's (tests/CMakeLists.txt), or one rank fewer's.
+  const char* other = std::getenv("DIEFILL_MPI_RESUME_FROM");
+  for (const int writer : {world_size(), other ? std::atoi(other) : world_size() - 1}) {
     if (writer < 1) continue;
     const std::filesystem::path from = checkpoint_of(writer);
     ASSERT_TRUE(std::filesystem::exists(from / "statistics.txt"))
@@ -610,6 +621,10 @@ TEST(MpiCheckpoint, AnyRankCountResumesWithTheSameForcesAndStatistics) {
     expect_same_forces(expected, forces_by_id(resumed), when.c_str());
     for (int n = 1; n < 200; ++n) dem::step(model, resumed);
     expect_every_grain_once(resumed, whole.size());
+    // Each rank restored its own piece as it was: the uninterrupted run's bits.
+    if (writer == world_size()) {
+      EXPECT_EQ(dem::state_hash(resumed), dem::state_hash(part)) << when << " on rank " << world_rank();
+    }
     const auto [k, z] = statistics(resumed);
     EXPECT_NEAR(k, expected_kinetic, 1e-9 * expected_kinetic) << when;
     EXPECT_NEAR(z, expected_height, 1e-9 * 6e-3) << when;
@@ -648,10 +663,12 @@ TEST(MpiChunked, MessagesInPiecesGiveTheSameBits) {
       dem::write_checkpoint(model, all, folder / file);
     }
   };
-  const auto bytes = [&](const char* file) {
+  const auto bytes = [&](const std::filesystem::path& file) {
     std::ifstream in(folder / file, std::ios::binary);
     return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   };
+  // This rank's piece of a split checkpoint (dem/checkpoint.hpp).
+  const auto piece = [&](const char* file) { return fmt::format("{}.rank-{}-of-{}", file, world_rank(), world_size()); };
   write_gathered(in_whole, "gathered-whole.bin");
   write_gathered(in_pieces, "gathered-pieces.bin");
   dem::write_checkpoint(model, in_whole, folder / "split-whole.bin");
@@ -659,13 +676,18 @@ TEST(MpiChunked, MessagesInPiecesGiveTheSameBits) {
   const dem::State resumed = dem::read_checkpoint(model, folder / "split-pieces.bin", dem::make_mpi_exchange(700));
   write_gathered(resumed, "gathered-resumed.bin");
   dem::write_checkpoint(model, resumed, folder / "split-resumed.bin");
+  // Every rank's piece of the checkpoints (the resumed run's too: the same rank count restores
+  // its state as it was), and rank 0's index.
+  const std::string split = bytes(piece("split-whole.bin"));
+  EXPECT_GT(split.size(), in_whole.owned() * sizeof(dem::GrainRecord));
+  EXPECT_TRUE(bytes(piece("split-pieces.bin")) == split) << "the checkpoint differs on rank " << world_rank();
+  EXPECT_TRUE(bytes(piece("split-resumed.bin")) == split) << "the resumed state's checkpoint differs on rank " << world_rank();
   if (world_rank() == 0) {
-    const std::string gathered = bytes("gathered-whole.bin"), split = bytes("split-whole.bin");
-    EXPECT_GT(split.size(), whole.size() * sizeof(dem::GrainRecord));
+    const std::string gathered = bytes("gathered-whole.bin");
     EXPECT_TRUE(bytes("gathered-pieces.bin") == gathered) << "the gathered state differs";
     EXPECT_TRUE(bytes("gathered-resumed.bin") == gathered) << "the gathered resumed state differs";
-    EXPECT_TRUE(bytes("split-pieces.bin") == split) << "the checkpoint differs";
-    EXPECT_TRUE(bytes("split-resumed.bin") == split) << "the resumed state's checkpoint differs";
+    EXPECT_TRUE(bytes("split-pieces.bin") == bytes("split-whole.bin")) << "the index differs";
+    EXPECT_TRUE(bytes("split-resumed.bin") == bytes("split-whole.bin")) << "the resumed state's index differs";
   }
 }
 
