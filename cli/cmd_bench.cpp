@@ -13,6 +13,7 @@
 #include <sstream>
 #include <thread>
 
+#include "cli/bench_mpi.hpp"
 #include "cli/commands.hpp"
 #include "cli/mpi_session.hpp"
 #include "dem/distributed.hpp"
@@ -283,8 +284,10 @@ int run_bench(const BenchCommand& c) {
                                   {"grains", run.report["particles"]["inserted"]},
                                   {"fill_ratio", run.report["fill"]["fill_ratio"]},
                                   {"timing", run.report["timing"]}});
+    } else if (name == "mpi-bed") {
+      results["cases"].push_back(run_mpi_bed(c));
     } else {
-      throw diefill::InputError("bench", name, "is not a benchmark case", "Use ring-10k, ring-100k, liggghts, scaling or run-ring");
+      throw diefill::InputError("bench", name, "is not a benchmark case", "Use ring-10k, ring-100k, liggghts, scaling, run-ring or mpi-bed");
     }
   }
   const std::string text = results.dump(2) + "\n";

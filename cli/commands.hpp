@@ -89,6 +89,9 @@ struct BenchCommand {
   std::filesystem::path pack;  // liggghts: the settled pack (LAMMPS dump)
   std::filesystem::path stl;   // liggghts: the container (mm)
   std::vector<std::size_t> sizes = {5000, 15000, 50000, 150000, 500000};  // scaling: grain counts
+  std::int64_t grains = 10'000'000;  // mpi-bed: the bed's grains
+  std::int64_t checkpoint_at = 0;    // mpi-bed: the step at which a checkpoint is written (0: none)
+  std::filesystem::path resume;      // mpi-bed: go on from this checkpoint
 };
 int run_bench(const BenchCommand& command);
 

@@ -4,7 +4,6 @@
 #include <cstring>
 #include <numeric>
 #include <stdexcept>
-#include <unordered_map>
 
 #include "core/error.hpp"
 
@@ -23,6 +22,21 @@ void append_grain(State& s, const GrainRecord& g) {
   s.f.push_back(Vec3::Zero()), s.torque.push_back(Vec3::Zero());
   s.radius.push_back(g.radius), s.mass.push_back(g.mass), s.inertia.push_back(g.inertia);
   s.material.push_back(g.material), s.active.push_back(g.active), s.body.push_back(-1);
+}
+
+IdIndex::IdIndex(const State& s, std::size_t count) : sorted_(count) {
+  for (std::size_t i = 0; i < count; ++i) sorted_[i] = {s.id[i], std::int64_t(i)};
+  std::sort(sorted_.begin(), sorted_.end());
+}
+
+std::int64_t IdIndex::find(std::int64_t id) const {
+  const auto at = std::lower_bound(sorted_.begin(), sorted_.end(), std::pair{id, std::int64_t(-1)});
+  return at != sorted_.end() && at->first == id ? at->second : -1;
+}
+
+void reserve_grains(State& s, std::size_t grains) {
+  const auto room = [grains](auto&... arrays) { (arrays.reserve(grains), ...); };
+  room(s.id, s.x, s.v, s.w, s.f, s.torque, s.radius, s.mass, s.inertia, s.material, s.active, s.body);
 }
 
 BodyRecord body_record(const Bodies& B, std::size_t b) {
@@ -105,15 +119,17 @@ BodiesImage gathered_bodies(const State& s) {
 
 void append_bodies(State& s, const BodiesImage& image) {
   if (image.bodies.empty()) return;
-  std::unordered_map<std::int64_t, std::int32_t> index;
-  for (std::size_t i = 0; i < s.size(); ++i) index.emplace(s.id[i], std::int32_t(i));
+  const IdIndex index(s, s.size());
   std::vector<std::int32_t> member;
   std::vector<Vec3> offset;
   std::size_t at = 0;
   for (const BodyRecord& body : image.bodies) {
     member.clear(), offset.clear();
-    for (std::int32_t k = 0; k < body.members; ++k, ++at)
-      member.push_back(index.at(image.members[at].id)), offset.push_back(image.members[at].offset);
+    for (std::int32_t k = 0; k < body.members; ++k, ++at) {
+      const std::int64_t i = index.find(image.members[at].id);
+      if (i < 0) throw std::logic_error("append_bodies: a clump's member is not in the state");
+      member.push_back(std::int32_t(i)), offset.push_back(image.members[at].offset);
+    }
     append_body(s, body, member.data(), offset.data());
   }
 }
@@ -123,10 +139,9 @@ std::vector<std::vector<CarriedPair>> contact_histories(const State& s) {
   std::vector<std::vector<CarriedPair>> pairs_of(owned);
   const NeighbourList& nl = s.neighbours;
   if (nl.row_start.size() != s.size() + 1) {
-    std::unordered_map<std::int64_t, std::size_t> index;
-    for (std::size_t i = 0; i < owned; ++i) index.emplace(s.id[i], i);
+    const IdIndex index(s, owned);
     for (const CarriedPair& c : s.carried_pairs)
-      if (const auto at = index.find(c.id); at != index.end()) pairs_of[at->second].push_back(c);
+      if (const std::int64_t i = index.find(c.id); i >= 0) pairs_of[std::size_t(i)].push_back(c);
     return pairs_of;
   }
   // A pair of two grains of this rank goes with both, as either may leave: a grain that took none

@@ -13,7 +13,24 @@
 namespace dem {
 
 GrainRecord grain_record(const State& state, std::size_t i);
+
+// The local index of each of a state's grains (its first `count`) by global id: a sorted table,
+// one allocation instead of a hash map's node per grain (at millions of grains the nodes
+// fragmented the heap).
+class IdIndex {
+ public:
+  IdIndex(const State& state, std::size_t count);
+  // -1 where no grain has the id.
+  std::int64_t find(std::int64_t id) const;
+
+ private:
+  std::vector<std::pair<std::int64_t, std::int64_t>> sorted_;
+};
 void append_grain(State& state, const GrainRecord& grain);
+// Room for `grains` grains in every per-grain array, exactly, before appending arrivals or
+// ghosts: appended one by one past the capacity, the arrays would double (a split run's memory
+// per grain is what limits it: docs/ARCHITECTURE.md, "Domain decomposition").
+void reserve_grains(State& state, std::size_t grains);
 
 // A clump's body as it travels between ranks (a migration, the gathered state, a split
 // checkpoint); its members travel as grains. A clump is never split: its members always live on

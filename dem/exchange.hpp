@@ -76,6 +76,9 @@ class Exchange {
   virtual std::int64_t global_collectives() const = 0;
   // How often the subdomains were cut, the first time included (a cut adds collectives of its own).
   virtual std::int64_t cuts() const = 0;
+  // The point-to-point messages this rank has sent so far, and their bytes.
+  virtual std::int64_t messages_sent() const = 0;
+  virtual std::int64_t bytes_sent() const = 0;
   // Every rank's bytes, concatenated in rank order, on rank 0 (empty elsewhere).
   virtual std::vector<char> gather(const std::vector<char>& local) = 0;
   virtual void barrier() = 0;

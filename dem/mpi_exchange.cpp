@@ -56,6 +56,8 @@ class MpiExchange final : public Exchange {
   void in_turn(const std::function<void()>& work) override;
   std::int64_t global_collectives() const override { return collectives_ + cuts_.collectives(); }
   std::int64_t cuts() const override { return cut_count_; }
+  std::int64_t messages_sent() const override { return messages_sent_; }
+  std::int64_t bytes_sent() const override { return bytes_sent_; }
   std::vector<char> gather(const std::vector<char>& local) override;
   void barrier() override {
     MPI_Barrier(MPI_COMM_WORLD);
@@ -96,7 +98,7 @@ class MpiExchange final : public Exchange {
   // The bytes alone, when the receiver knows how many each rank of `from` sends (ascending offsets
   // into the result, one more than `from`).
   std::vector<char> move_bytes(const std::vector<Outgoing>& out, const std::vector<int>& from,
-                               const std::vector<std::size_t>& at) const;
+                               const std::vector<std::size_t>& at);
 
   // Each rank's buffer to it; returns what every rank sent here, in rank order.
   std::vector<char> all_to_all(const std::vector<std::vector<char>>& out);
@@ -125,7 +127,7 @@ class MpiExchange final : public Exchange {
   // From the step's agree(): the heaviest rank's work and the mean, for the rebuild it may call.
   bool agreed_ = false;
   double heaviest_ = 0, mean_ = 0;
-  std::int64_t collectives_ = 0, cut_count_ = 0;
+  std::int64_t collectives_ = 0, cut_count_ = 0, messages_sent_ = 0, bytes_sent_ = 0;
 };
 
 // The work a rank's grains carry, as migrate weighs it: each active grain, and its listed pairs.
@@ -215,6 +217,7 @@ std::vector<char> MpiExchange::transfer(const std::vector<Outgoing>& out, const 
   for (std::size_t k = 0; k < out.size(); ++k) {
     sizes[k] = out[k].bytes->size();
     MPI_Isend(&sizes[k], 1, MPI_UINT64_T, out[k].to, 0, MPI_COMM_WORLD, &requests.emplace_back());
+    ++messages_sent_, bytes_sent_ += std::int64_t(sizeof sizes[k]);
   }
   MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
   std::vector<std::size_t> at(from.size() + 1, 0);
@@ -224,7 +227,7 @@ std::vector<char> MpiExchange::transfer(const std::vector<Outgoing>& out, const 
 }
 
 std::vector<char> MpiExchange::move_bytes(const std::vector<Outgoing>& out, const std::vector<int>& from,
-                                          const std::vector<std::size_t>& at) const {
+                                          const std::vector<std::size_t>& at) {
   std::vector<char> received(at.back());
   std::vector<MPI_Request> requests;
   // Both sides cut a buffer alike, from its size; MPI keeps the order of the messages between two
@@ -235,8 +238,10 @@ std::vector<char> MpiExchange::move_bytes(const std::vector<Outgoing>& out, cons
       MPI_Irecv(received.data() + at[k] + o, piece(at[k + 1] - at[k], o), MPI_BYTE, from[k], 1, MPI_COMM_WORLD,
                 &requests.emplace_back());
   for (const Outgoing& o : out)
-    for (std::size_t b = 0; b < o.bytes->size(); b += largest_message_)
+    for (std::size_t b = 0; b < o.bytes->size(); b += largest_message_) {
       MPI_Isend(o.bytes->data() + b, piece(o.bytes->size(), b), MPI_BYTE, o.to, 1, MPI_COMM_WORLD, &requests.emplace_back());
+      ++messages_sent_, bytes_sent_ += piece(o.bytes->size(), b);
+    }
   MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
   return received;
 }
@@ -267,22 +272,15 @@ void MpiExchange::redistribute(const Model& model, State& s) {
   send_ghosts(model, s);
 }
 
-// Grains move by units: a free grain goes where its centre lies, a clump where its body's centre
-// lies, with all its members (the body's force is summed from its members' on one rank).
-void MpiExchange::migrate(State& s) {
-  const std::size_t owned = s.owned();
+// The subdomains' weights: a grain costs itself and its listed pairs; a clump, its members
+// together, at its body's centre.
+std::vector<WeightedPoint> weighted_points(const State& s) {
   const NeighbourList& nl = s.neighbours;
   const Bodies& B = s.bodies;
   const bool listed = nl.row_start.size() == s.size() + 1;
-  // What each owned grain takes along: its pairs' histories (as it sees them), its wall contacts.
-  const std::vector<std::vector<CarriedPair>> pairs_of = contact_histories(s);
-  std::vector<const WallSlot*> slots_of(owned, nullptr);
-  if (s.wall_slots.size() == nl.near_wall.size() * wall_slots_per_particle)
-    for (std::size_t q = 0; q < nl.near_wall.size(); ++q) slots_of[std::size_t(nl.near_wall[q])] = &s.wall_slots[q * wall_slots_per_particle];
-  // The cost of a grain: its listed pairs, and itself; a clump's, its members' together.
   const auto cost = [&](std::size_t i) { return 1 + (listed ? std::int64_t(nl.row_start[i + 1] - nl.row_start[i]) : 0); };
   std::vector<WeightedPoint> points;
-  for (std::size_t i = 0; i < owned; ++i)
+  for (std::size_t i = 0; i < s.owned(); ++i)
     if (s.active[i] && s.body[i] < 0) points.push_back({s.x[i], cost(i)});
   for (std::size_t b = 0; b < B.size(); ++b)
     if (B.active[b]) {
@@ -290,7 +288,72 @@ void MpiExchange::migrate(State& s) {
       for (std::int32_t k = B.member_start[b]; k < B.member_start[b + 1]; ++k) weight += cost(std::size_t(B.member[std::size_t(k)]));
       points.push_back({B.x[b], weight});
     }
+  return points;
+}
 
+// The pair histories at a migration: a grain that leaves takes its own view of each of its pairs
+// (leaving[k] for the k-th leaving grain; a pair of two leaving grains goes with both, as either
+// may be sent elsewhere); one that stays keeps, by id, one view of each pair with a ghost or a
+// leaving grain, which the rebuild matches either way. A pair of two staying grains stays in the
+// list, read by index at the rebuild (State::renumbered). Before the first list, the histories
+// are those carried in already.
+struct MigratingHistories {
+  std::vector<CarriedPair> staying;
+  std::vector<std::vector<CarriedPair>> leaving;
+};
+MigratingHistories migrating_histories(const State& s, const std::vector<int>& to, int rank,
+                                       const std::vector<std::int32_t>& leaving_index, std::size_t leaving_count) {
+  MigratingHistories h;
+  h.leaving.resize(leaving_count);
+  const NeighbourList& nl = s.neighbours;
+  const std::size_t owned = s.owned();
+  const auto keep = [&](std::size_t i, const CarriedPair& c) {
+    if (to[i] == rank) h.staying.push_back(c);
+    else h.leaving[std::size_t(leaving_index[i])].push_back(c);
+  };
+  if (nl.row_start.size() != s.size() + 1) {
+    const IdIndex index(s, owned);
+    for (const CarriedPair& c : s.carried_pairs)
+      if (const std::int64_t i = index.find(c.id); i >= 0) keep(std::size_t(i), c);
+    return h;
+  }
+  for (std::size_t i = 0; i < owned; ++i)
+    for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p) {
+      const Vec3 t = nl.tangential.empty() ? Vec3::Zero() : nl.tangential[std::size_t(p)];
+      const Vec3 r = nl.rolling.empty() ? Vec3::Zero() : nl.rolling[std::size_t(p)];
+      if (t.squaredNorm() == 0 && r.squaredNorm() == 0) continue;
+      const std::size_t j = std::size_t(nl.partner[std::size_t(p)]);
+      const bool both_stay = to[i] == rank && j < owned && to[j] == rank;
+      if (both_stay) continue;
+      keep(i, {s.id[i], s.id[j], t, r});
+      if (j < owned) keep(j, {s.id[j], s.id[i], -t, -r});  // the partner's own view
+    }
+  return h;
+}
+
+// The grains in a migration's buffer (its layout: migrate).
+std::size_t arrivals(const std::vector<char>& received) {
+  std::size_t grains = 0;
+  const auto skip_grain = [&](const char*& at) {
+    const Migrant m = take<Migrant>(at);
+    at += (m.near_wall ? wall_slots_per_particle * sizeof(WallSlot) : 0) + std::size_t(m.pairs) * sizeof(CarriedPair);
+    ++grains;
+  };
+  for (const char* at = received.data(); at < received.data() + received.size();) {
+    const auto members = take<std::int32_t>(at);
+    if (members > 0) at += sizeof(BodyRecord) + std::size_t(members) * sizeof(Vec3);
+    for (std::int32_t k = 0; k < std::max(members, 1); ++k) skip_grain(at);
+  }
+  return grains;
+}
+
+// Grains move by units: a free grain goes where its centre lies, a clump where its body's centre
+// lies, with all its members (the body's force is summed from its members' on one rank).
+void MpiExchange::migrate(State& s) {
+  const std::size_t owned = s.owned();
+  const NeighbourList& nl = s.neighbours;
+  const Bodies& B = s.bodies;
+  const bool listed = nl.row_start.size() == s.size() + 1;
   // Cut anew at the first call, or when the heaviest rank carries more than 1.2 times the mean
   // (weighed by the step's agree(), or here when no step came before: initialize()). Also whenever
   // the grains come without a list (shared anew, resumed, a round inserted; every rank alike): the
@@ -303,63 +366,86 @@ void MpiExchange::migrate(State& s) {
   }
   agreed_ = false;
   recut_ = cuts_.empty() || !listed || heaviest_ > 1.2 * mean_;
-  if (recut_) cuts_.cut(points), ++cut_count_;
+  if (recut_) cuts_.cut(weighted_points(s)), ++cut_count_;
 
-  std::vector<std::vector<char>> out(static_cast<std::size_t>(ranks_));
-  std::vector<std::size_t> keep;
-  Array<std::int32_t> near;
-  Array<WallSlot> slots;
-  std::vector<CarriedPair> carried;
+  // Where each owned grain goes; a lost grain stays where it was lost: it takes part in nothing.
   // Between two cuts a grain moves less than half the skin between rebuilds, less than the ghost
   // reach, so it migrates to a neighbour; after a cut every rank may send to every other.
-  const auto stay = [&](std::size_t i) {
-    keep.push_back(i);
-    if (slots_of[i]) {
-      near.push_back(std::int32_t(keep.size() - 1));
-      slots.insert(slots.end(), slots_of[i], slots_of[i] + wall_slots_per_particle);
-    }
-    carried.insert(carried.end(), pairs_of[i].begin(), pairs_of[i].end());
-  };
-  const auto send = [&](std::vector<char>& b, std::size_t i) {
-    put(b, Migrant{grain_record(s, i), std::int32_t(pairs_of[i].size()), std::uint8_t(slots_of[i] ? 1 : 0)});
-    if (slots_of[i])
-      for (int k = 0; k < wall_slots_per_particle; ++k) put(b, slots_of[i][k]);
-    for (const CarriedPair& c : pairs_of[i]) put(b, c);
-  };
-  // A unit's destination; a lost grain stays where it was lost: it takes part in nothing.
   const auto destination = [&](bool active, const Vec3& x) {
     const int to = active ? cuts_.owner(x) : rank_;
     if (!recut_ && to != rank_ && !std::binary_search(neighbours_.begin(), neighbours_.end(), to))
       throw std::logic_error("migrate: a grain moved beyond the neighbouring subdomains between two rebuilds");
     return to;
   };
+  std::vector<int> to(owned, rank_);
+  for (std::size_t i = 0; i < owned; ++i)
+    if (s.body[i] < 0) to[i] = destination(s.active[i] != 0, s.x[i]);
+  for (std::size_t b = 0; b < B.size(); ++b) {
+    const int d = destination(B.active[b] != 0, B.x[b]);
+    for (std::int32_t k = B.member_start[b]; k < B.member_start[b + 1]; ++k) to[std::size_t(B.member[std::size_t(k)])] = d;
+  }
+  std::vector<std::int32_t> leaving_index(owned, -1);
+  std::size_t leaving = 0;
+  for (std::size_t i = 0; i < owned; ++i)
+    if (to[i] != rank_) leaving_index[i] = std::int32_t(leaving++);
+  // What each grain takes along: its pairs' histories (as it sees them), its wall contacts.
+  MigratingHistories histories = migrating_histories(s, to, rank_, leaving_index, leaving);
+  std::vector<const WallSlot*> slots_of(owned, nullptr);
+  if (s.wall_slots.size() == nl.near_wall.size() * wall_slots_per_particle)
+    for (std::size_t q = 0; q < nl.near_wall.size(); ++q) slots_of[std::size_t(nl.near_wall[q])] = &s.wall_slots[q * wall_slots_per_particle];
+
+  std::vector<std::vector<char>> out(static_cast<std::size_t>(ranks_));
+  std::vector<std::size_t> keep;
+  keep.reserve(owned - leaving);
+  Array<std::int32_t> near;
+  Array<WallSlot> slots;
+  const auto stay = [&](std::size_t i) {
+    keep.push_back(i);
+    if (slots_of[i]) {
+      near.push_back(std::int32_t(keep.size() - 1));
+      slots.insert(slots.end(), slots_of[i], slots_of[i] + wall_slots_per_particle);
+    }
+  };
+  const auto send = [&](std::vector<char>& b, std::size_t i) {
+    std::vector<CarriedPair>& pairs = histories.leaving[std::size_t(leaving_index[i])];
+    put(b, Migrant{grain_record(s, i), std::int32_t(pairs.size()), std::uint8_t(slots_of[i] ? 1 : 0)});
+    if (slots_of[i])
+      for (int k = 0; k < wall_slots_per_particle; ++k) put(b, slots_of[i][k]);
+    for (const CarriedPair& c : pairs) put(b, c);
+    std::vector<CarriedPair>().swap(pairs);
+  };
   // Each unit in the buffer: its member count (0: a free grain), for a clump its body and offsets,
   // then its grains.
   for (std::size_t i = 0; i < owned; ++i) {
     if (s.body[i] >= 0) continue;
-    const int to = destination(s.active[i] != 0, s.x[i]);
-    if (to == rank_) {
+    if (to[i] == rank_) {
       stay(i);
       continue;
     }
-    put(out[std::size_t(to)], std::int32_t{0});
-    send(out[std::size_t(to)], i);
+    put(out[std::size_t(to[i])], std::int32_t{0});
+    send(out[std::size_t(to[i])], i);
   }
   for (std::size_t b = 0; b < B.size(); ++b) {
-    const int to = destination(B.active[b] != 0, B.x[b]);
     const auto first = B.member_start[b], last = B.member_start[b + 1];
-    if (to == rank_) {
+    const int d = to[std::size_t(B.member[std::size_t(first)])];
+    if (d == rank_) {
       for (std::int32_t k = first; k < last; ++k) stay(std::size_t(B.member[std::size_t(k)]));
       continue;
     }
-    std::vector<char>& buffer = out[std::size_t(to)];
+    std::vector<char>& buffer = out[std::size_t(d)];
     put(buffer, std::int32_t(last - first));
     put(buffer, body_record(B, b));
     for (std::int32_t k = first; k < last; ++k) put(buffer, B.offset[std::size_t(k)]);
     for (std::int32_t k = first; k < last; ++k) send(buffer, std::size_t(B.member[std::size_t(k)]));
   }
+  histories.leaving = {};
   const std::vector<char> received = recut_ ? all_to_all(out) : with_neighbours(out);
+  out = {};
+  s.renumbered.assign(listed ? s.size() : 0, -1);
+  for (std::size_t k = 0; listed && k < keep.size(); ++k) s.renumbered[keep[k]] = std::int32_t(k);
   keep_grains(s, keep);
+  reserve_grains(s, keep.size() + arrivals(received));
+  std::vector<CarriedPair>& carried = histories.staying;
   const auto arrive = [&](const char*& at) {
     const Migrant m = take<Migrant>(at);
     append_grain(s, m.grain);
@@ -421,6 +507,7 @@ void MpiExchange::send_ghosts(const Model& model, State& s) {
   }
   const std::vector<char> received = with_neighbours(out, &ghost_at_);
   for (std::size_t& at : ghost_at_) at = at / sizeof(GrainRecord) * sizeof(GhostMotion);
+  reserve_grains(s, s.size() + received.size() / sizeof(GrainRecord));
   for (const char* at = received.data(); at < received.data() + received.size(); ++s.ghosts) {
     append_grain(s, take<GrainRecord>(at));
   }

@@ -6,6 +6,7 @@
 #include <limits>
 #include <numeric>
 
+#include "dem/distributed.hpp"
 #include "dem/walls.hpp"
 
 namespace dem {
@@ -65,6 +66,9 @@ CellGrid make_grid(const Model& model, const State& s) {
 template <typename Values>
 void permute(Values& a, const std::vector<std::int32_t>& order) {
   static thread_local Values scratch;
+  // Exactly the size (a resize past the capacity could double it, and the arrays take turns
+  // with the scratch).
+  if (scratch.capacity() < order.size()) scratch.clear(), scratch.reserve(order.size());
   scratch.resize(order.size());
   for (std::size_t n = 0; n < order.size(); ++n) scratch[n] = a[std::size_t(order[n])];
   a.swap(scratch);
@@ -172,33 +176,60 @@ void index_cross_pairs(NeighbourList& nl, std::size_t n, std::size_t owned) {
   }
 }
 
-// The histories of the list's pairs, by (old) particle index.
-std::vector<OldPair> listed_histories(const NeighbourList& nl) {
-  std::vector<OldPair> old;
-  old.reserve(nl.partner.size() / 2);
+// The old pairs' histories grouped by row, the smaller new index of the two (the history is
+// its view: the other's is negated): row i's are [start[i], start[i+1]), each its partner and
+// its springs (tangential only under a tangential law, rolling only under EPSD), kept as arrays
+// apart (a third of the bytes of whole records at a rebuild of millions of grains). A counting
+// sort in two passes over `visit`, which calls add(OldPair) for every pair, so that no list of
+// them is held in between; each row keeps the order `visit` gives.
+struct RowHistories {
+  std::vector<std::int32_t> start, partner;
+  Array<Vec3> tangential, rolling;
+};
+template <typename Visit>
+void histories_by_row(std::size_t n, bool tangential, bool rolling, Visit visit, RowHistories& h) {
+  const auto smaller_first = [](OldPair o) {
+    if (o.i > o.j) std::swap(o.i, o.j), o.tangential = -o.tangential, o.rolling = -o.rolling;
+    return o;
+  };
+  h.start.assign(n + 1, 0);
+  visit([&](const OldPair& o) { ++h.start[std::size_t(smaller_first(o).i) + 1]; });
+  for (std::size_t i = 0; i < n; ++i) h.start[i + 1] += h.start[i];
+  const auto total = std::size_t(h.start[n]);
+  h.partner.resize(total);
+  h.tangential.resize(tangential ? total : 0);
+  h.rolling.resize(rolling ? total : 0);
+  std::vector<std::int32_t> fill(h.start.begin(), h.start.end() - 1);
+  visit([&](const OldPair& o) {
+    const OldPair first = smaller_first(o);
+    const auto k = std::size_t(fill[std::size_t(first.i)]++);
+    h.partner[k] = first.j;
+    if (tangential) h.tangential[k] = first.tangential;
+    if (rolling) h.rolling[k] = first.rolling;
+  });
+}
+
+// The histories of the list's pairs, by their particles' new indices: new_index[i] of the list's
+// particle i, or after a migration new_index[renumbered[i]], skipping a pair of a grain that left.
+template <typename Add>
+void visit_listed_histories(const NeighbourList& nl, const std::vector<std::int32_t>& renumbered,
+                            const std::vector<std::int32_t>& new_index, Add add) {
+  const auto now = [&](std::size_t i) { return renumbered.empty() ? new_index[i] : renumbered[i] < 0 ? -1 : new_index[std::size_t(renumbered[i])]; };
   for (std::size_t i = 0; i + 1 < nl.row_start.size(); ++i)
     for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p) {
       const Vec3 t = nl.tangential.empty() ? Vec3::Zero() : nl.tangential[std::size_t(p)];
       const Vec3 r = nl.rolling.empty() ? Vec3::Zero() : nl.rolling[std::size_t(p)];
-      if (t.squaredNorm() > 0 || r.squaredNorm() > 0) old.push_back({std::int32_t(i), nl.partner[std::size_t(p)], t, r});
+      if (t.squaredNorm() == 0 && r.squaredNorm() == 0) continue;
+      if (const std::int32_t a = now(i), b = now(std::size_t(nl.partner[std::size_t(p)])); a >= 0 && b >= 0) add(OldPair{a, b, t, r});
     }
-  return old;
 }
 
 // The histories that came with migrated grains (global ids), by their new local indices.
-std::vector<OldPair> carried_histories(State& s) {
-  std::vector<std::pair<std::int64_t, std::int32_t>> index_of(s.size());
-  for (std::size_t i = 0; i < s.size(); ++i) index_of[i] = {s.id[i], std::int32_t(i)};
-  std::sort(index_of.begin(), index_of.end());
-  const auto find = [&](std::int64_t id) {
-    const auto at = std::lower_bound(index_of.begin(), index_of.end(), std::pair{id, std::int32_t(-1)});
-    return at != index_of.end() && at->first == id ? at->second : -1;
-  };
-  std::vector<OldPair> old;
+template <typename Add>
+void visit_carried_histories(const State& s, const IdIndex& index, Add add) {
   for (const CarriedPair& c : s.carried_pairs)
-    if (const std::int32_t i = find(c.id), j = find(c.partner); i >= 0 && j >= 0) old.push_back({i, j, c.tangential, c.rolling});
-  s.carried_pairs.clear();
-  return old;
+    if (const std::int64_t i = index.find(c.id), j = index.find(c.partner); i >= 0 && j >= 0)
+      add(OldPair{std::int32_t(i), std::int32_t(j), c.tangential, c.rolling});
 }
 
 }  // namespace
@@ -239,11 +270,10 @@ void rebuild_neighbours(const Model& model, State& s) {
         lose(std::size_t(bodies.member[std::size_t(k)]));
     }
 
-  // Old pairs with their history, by particle index before sorting (or, split over ranks, the
-  // histories that came with the grains, by global id: exchange.hpp).
+  // The old pairs' histories come from the list (or, split over ranks, with the grains, by global
+  // id: exchange.hpp), matched to the new list's pairs below.
   NeighbourList& nl = s.neighbours;
   const bool tangential = model.tangential != TangentialLaw::none, rolling = model.rolling == RollingLaw::epsd;
-  std::vector<OldPair> old = s.exchange ? std::vector<OldPair>() : listed_histories(nl);
   const Array<std::int32_t> old_near = nl.near_wall;
   const Array<WallSlot> old_slots = std::move(s.wall_slots);
 
@@ -252,28 +282,21 @@ void rebuild_neighbours(const Model& model, State& s) {
   const std::vector<std::int32_t> order = sort_particles(s, grid, new_index);
   if (s.exchange) s.exchange->reordered(new_index);
   grid = make_grid(model, s);  // members now ascending along the cells
-  if (s.exchange) old = carried_histories(s);
-  else
-    for (OldPair& o : old) o.i = new_index[std::size_t(o.i)], o.j = new_index[std::size_t(o.j)];
-  // Smaller index first (history is i's view: negate).
-  for (OldPair& o : old) {
-    if (o.i > o.j) {
-      std::swap(o.i, o.j);
-      o.tangential = -o.tangential;
-      o.rolling = -o.rolling;
-    }
-  }
   // By row, in a counting sort (linear, stable: within a row the old list's order, the same every
   // run; split over ranks, a pair that met across a subdomain face comes once from each side, the
   // two views agreeing to rounding, and the first is taken).
   const std::size_t n = s.size();
-  std::vector<std::int32_t> old_start(n + 1, 0);
-  for (const OldPair& o : old) ++old_start[std::size_t(o.i) + 1];
-  for (std::size_t i = 0; i < n; ++i) old_start[i + 1] += old_start[i];
-  std::vector<OldPair> old_by_row(old.size());
-  {
-    std::vector<std::int32_t> fill(old_start.begin(), old_start.end() - 1);
-    for (const OldPair& o : old) old_by_row[std::size_t(fill[std::size_t(o.i)]++)] = o;
+  RowHistories old;
+  if (s.exchange) {
+    const IdIndex index(s, n);
+    histories_by_row(n, tangential, rolling, [&](auto add) {
+      if (!s.renumbered.empty()) visit_listed_histories(nl, s.renumbered, new_index, add);
+      visit_carried_histories(s, index, add);
+    }, old);
+    std::vector<CarriedPair>().swap(s.carried_pairs);
+    std::vector<std::int32_t>().swap(s.renumbered);
+  } else {
+    histories_by_row(n, tangential, rolling, [&](auto add) { visit_listed_histories(nl, {}, new_index, add); }, old);
   }
 
   // Rows in parallel: every owned particle scans the 27 cells around it for j > i within reach
@@ -326,16 +349,17 @@ void rebuild_neighbours(const Model& model, State& s) {
   nl.rolling.assign(rolling ? pairs : 0, Vec3::Zero());
   nl.touching.assign(pairs, 0);
   for (std::size_t i = 0; i < n; ++i) {
-    const auto history_begin = old_by_row.begin() + old_start[i], history_end = old_by_row.begin() + old_start[i + 1];
+    const auto history_begin = old.partner.begin() + old.start[i], history_end = old.partner.begin() + old.start[i + 1];
     const std::int32_t* row = found[std::size_t(row_thread[i])].data() + row_begin[i];
     for (std::int32_t k = 0, p = nl.row_start[i]; k < row_length[i]; ++k, ++p) {
       const std::int32_t j = row[k];
       nl.partner[std::size_t(p)] = j;
       // A grain has a dozen listed partners, a few with history: a scan beats a search.
-      const auto history = std::find_if(history_begin, history_end, [j](const OldPair& o) { return o.j == j; });
+      const auto history = std::find(history_begin, history_end, j);
       if (history != history_end) {
-        if (tangential) nl.tangential[std::size_t(p)] = history->tangential;
-        if (rolling) nl.rolling[std::size_t(p)] = history->rolling;
+        const auto h = std::size_t(history - old.partner.begin());
+        if (tangential) nl.tangential[std::size_t(p)] = old.tangential[h];
+        if (rolling) nl.rolling[std::size_t(p)] = old.rolling[h];
         nl.touching[std::size_t(p)] = 1;
       }
     }

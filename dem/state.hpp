@@ -144,6 +144,10 @@ struct State {
   std::shared_ptr<Exchange> exchange;
   std::size_t ghosts = 0;
   std::vector<CarriedPair> carried_pairs;
+  // After a migration, until the next build: the new index of each grain of the list built before
+  // it (-1: it left, or was a ghost), so that the pairs of two grains that stayed keep their
+  // histories from that list by index (the others' come by id, in carried_pairs).
+  std::vector<std::int32_t> renumbered;
 
   double time = 0;              // [s]
   std::int64_t step = 0;
