@@ -195,8 +195,9 @@ json run_mpi_bed(const BenchCommand& c) {
     most_messages = std::max(most_messages, traffic[r]), most_bytes = std::max(most_bytes, traffic[r + 1]);
     all_messages += traffic[r], all_bytes += traffic[r + 1];
   }
+  // The particle output once, by the run from the start (a resumed one only times its steps).
   clock.restart();
-  const fs::path particles = dem::write_vtu(s, out / (c.resume.empty() ? "particles.vtu" : fmt::format("particles_resumed_{}.vtu", ranks.ranks())));
+  const fs::path particles = c.resume.empty() ? dem::write_vtu(s, out / "particles.vtu") : fs::path();
   const double output_s = ranks.max(clock.seconds());
   const double owned = double(std::max<std::size_t>(1, s.owned()));
   const double bytes_per_owned = ranks.max(peak_resident_bytes() / owned);
