@@ -230,17 +230,7 @@ void append_owned(State& s, State piece) {
   std::vector<std::size_t> owned(piece.owned());
   std::iota(owned.begin(), owned.end(), std::size_t{0});
   keep_grains(piece, owned);
-  for (std::size_t i = 0; i < piece.size(); ++i) {
-    append_grain(s, grain_record(piece, i));
-    s.f.back() = piece.f[i], s.torque.back() = piece.torque[i];
-  }
-  const Bodies& B = piece.bodies;
-  std::vector<std::int32_t> member;
-  for (std::size_t b = 0; b < B.size(); ++b) {
-    member.clear();
-    for (std::int32_t k = B.member_start[b]; k < B.member_start[b + 1]; ++k) member.push_back(first + B.member[std::size_t(k)]);
-    append_body(s, body_record(B, b), member.data(), &B.offset[std::size_t(B.member_start[b])]);
-  }
+  append_grains(s, piece);
   s.carried_pairs.insert(s.carried_pairs.end(), pairs.begin(), pairs.end());
   s.counters.max_overlap_rel = std::max(s.counters.max_overlap_rel, piece.counters.max_overlap_rel);
   s.counters.checked_overlap_rel = std::max(s.counters.checked_overlap_rel, piece.counters.checked_overlap_rel);

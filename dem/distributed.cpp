@@ -137,26 +137,30 @@ void append_bodies(State& s, const BodiesImage& image) {
 std::vector<std::vector<CarriedPair>> contact_histories(const State& s) {
   const std::size_t owned = s.owned();
   std::vector<std::vector<CarriedPair>> pairs_of(owned);
-  const NeighbourList& nl = s.neighbours;
-  if (nl.row_start.size() != s.size() + 1) {
-    const IdIndex index(s, owned);
-    for (const CarriedPair& c : s.carried_pairs)
-      if (const std::int64_t i = index.find(c.id); i >= 0) pairs_of[std::size_t(i)].push_back(c);
-    return pairs_of;
-  }
   // A pair of two grains of this rank goes with both, as either may leave: a grain that took none
   // to a rank where its partner is a ghost would start the pair afresh there, while the partner's
   // rank kept the spring (the pair's two forces then differ, and momentum drifts).
-  for (std::size_t i = 0; i < owned; ++i)
-    for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p) {
-      const Vec3 t = nl.tangential.empty() ? Vec3::Zero() : nl.tangential[std::size_t(p)];
-      const Vec3 r = nl.rolling.empty() ? Vec3::Zero() : nl.rolling[std::size_t(p)];
-      if (t.squaredNorm() == 0 && r.squaredNorm() == 0) continue;
-      const std::size_t j = std::size_t(nl.partner[std::size_t(p)]);
-      pairs_of[i].push_back({s.id[i], s.id[j], t, r});
-      if (j < owned) pairs_of[j].push_back({s.id[j], s.id[i], -t, -r});
-    }
+  for_each_history(s, [&](std::size_t i, std::int64_t j, const CarriedPair& c) {
+    pairs_of[i].push_back(c);
+    if (j >= 0 && std::size_t(j) < owned) pairs_of[std::size_t(j)].push_back(other_view(c));
+  });
   return pairs_of;
+}
+
+void append_grains(State& s, const State& part) {
+  const auto first = std::int32_t(s.size());
+  reserve_grains(s, s.size() + part.size());
+  for (std::size_t i = 0; i < part.size(); ++i) {
+    append_grain(s, grain_record(part, i));
+    s.f.back() = part.f[i], s.torque.back() = part.torque[i];
+  }
+  const Bodies& B = part.bodies;
+  std::vector<std::int32_t> member;
+  for (std::size_t b = 0; b < B.size(); ++b) {
+    member.clear();
+    for (std::int32_t k = B.member_start[b]; k < B.member_start[b + 1]; ++k) member.push_back(first + B.member[std::size_t(k)]);
+    append_body(s, body_record(B, b), member.data(), &B.offset[std::size_t(B.member_start[b])]);
+  }
 }
 
 std::vector<std::size_t> share_indices(const State& whole, const Exchange& exchange) {
@@ -201,15 +205,7 @@ void add_share(State& s, const State& fresh) {
   s.carried_pairs = std::move(carried);
   State share = fresh;
   keep_grains(share, share_indices(fresh, *s.exchange));
-  const auto first = std::int32_t(s.size());
-  for (std::size_t i = 0; i < share.size(); ++i) append_grain(s, grain_record(share, i));
-  const Bodies& B = share.bodies;
-  std::vector<std::int32_t> member;
-  for (std::size_t b = 0; b < B.size(); ++b) {
-    member.clear();
-    for (std::int32_t k = B.member_start[b]; k < B.member_start[b + 1]; ++k) member.push_back(first + B.member[std::size_t(k)]);
-    append_body(s, body_record(B, b), member.data(), &B.offset[std::size_t(B.member_start[b])]);
-  }
+  append_grains(s, share);
 }
 
 bool writes_outputs(const State& s) { return !s.exchange || s.exchange->rank() == 0; }

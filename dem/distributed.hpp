@@ -66,9 +66,18 @@ BodiesImage gathered_bodies(const State& state);
 // Appends the image's bodies to a state that holds their members (found by id).
 void append_bodies(State& state, const BodiesImage& image);
 
+// Every pair history a state holds: use(i, j, history as owned grain i sees it) for each listed
+// pair of i with a spring (j its partner's index, owned or a ghost), or, before the first list is
+// built, for each of carried_pairs whose grain i is here (j = -1).
+template <typename Use>
+void for_each_history(const State& state, Use use);
+
 // Per owned grain, the histories of its pairs as it sees them: from the neighbour list (a pair of
 // two owned grains listed for both), or, before the first list is built, from carried_pairs.
 std::vector<std::vector<CarriedPair>> contact_histories(const State& state);
+
+// Appends `part`'s grains (with their forces) and clumps to `state`.
+void append_grains(State& state, const State& part);
 
 // Which grains of a state every rank holds alike (read from one file, drawn from one seed) this
 // rank takes: every ranks-th unit (a free grain, or a clump with all its members), from its rank
@@ -96,5 +105,28 @@ void with_whole_state(const State& state, const std::function<void(const State&)
 // rank learns whether it failed anywhere: the failed ones rethrow their error, the others throw
 // InputError. Collective. No exchange: runs `work`, its error unchanged.
 void run_and_agree(Exchange* exchange, bool here, const std::function<void()>& work);
+
+template <typename Use>
+void for_each_history(const State& s, Use use) {
+  const std::size_t owned = s.owned();
+  const NeighbourList& nl = s.neighbours;
+  if (nl.row_start.size() != s.size() + 1) {
+    const IdIndex index(s, owned);
+    for (const CarriedPair& c : s.carried_pairs)
+      if (const std::int64_t i = index.find(c.id); i >= 0) use(std::size_t(i), std::int64_t(-1), c);
+    return;
+  }
+  for (std::size_t i = 0; i < owned; ++i)
+    for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p) {
+      const Vec3 t = nl.tangential.empty() ? Vec3::Zero() : nl.tangential[std::size_t(p)];
+      const Vec3 r = nl.rolling.empty() ? Vec3::Zero() : nl.rolling[std::size_t(p)];
+      if (t.squaredNorm() == 0 && r.squaredNorm() == 0) continue;
+      const std::size_t j = std::size_t(nl.partner[std::size_t(p)]);
+      use(i, std::int64_t(j), CarriedPair{s.id[i], s.id[j], t, r});
+    }
+}
+
+// The same pair as its other grain sees it.
+inline CarriedPair other_view(const CarriedPair& c) { return {c.partner, c.id, -c.tangential, -c.rolling}; }
 
 }  // namespace dem

@@ -40,7 +40,7 @@ std::vector<std::string_view> split(std::string_view line) {
 
 }  // namespace
 
-State read_particles_csv(const fs::path& path, int material, double default_density) {
+State read_particles_csv(const fs::path& path, int material, double default_density, RowShare share) {
   std::ifstream in(path);
   if (!in) throw InputError(path.string(), "", "cannot be read", "Check the path");
   std::string header;
@@ -58,8 +58,10 @@ State read_particles_csv(const fs::path& path, int material, double default_dens
   const bool has_body = column.count("body") > 0;
   State s;
   std::string line;
+  std::size_t rows = 0;
   for (std::size_t number = 2; std::getline(in, line); ++number) {
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    const bool mine = rows++ % std::size_t(share.ranks) == std::size_t(share.rank);
     const auto cells = split(line);
     auto value = [&](const char* name) {
       const std::size_t c = column.at(name);
@@ -91,9 +93,9 @@ State read_particles_csv(const fs::path& path, int material, double default_dens
     if (!has_density && !(density > 0))
       throw InputError(path.string(), "column density", "is missing and no material density is given",
                        "Add a density column, or name the material (scene) or pass --material-density");
-    s.add_sphere(std::int64_t(id), x, radius, density, material, v, w);
+    if (mine) s.add_sphere(std::int64_t(id), x, radius, density, material, v, w);
   }
-  if (s.size() == 0) throw InputError(path.string(), "", "holds no particles", "Add rows below the header");
+  if (rows == 0) throw InputError(path.string(), "", "holds no particles", "Add rows below the header");
   return s;
 }
 

@@ -14,7 +14,14 @@ namespace dem {
 // body,qw,qx,qy,qz are accepted and ignored for free spheres, body -1; a clump member throws). Grains get `material`, and
 // `default_density` when the file has no density column. Throws InputError naming the file,
 // the line and the column for missing columns, unparsable or non-finite values.
-State read_particles_csv(const std::filesystem::path& path, int material, double default_density);
+//
+// With `share` (a split run: every rank reads the file), this rank keeps every share.ranks-th row
+// from row share.rank on, the grains share_of would keep, and no rank holds them all; every row is
+// checked on every rank, so that a bad one stops all alike.
+struct RowShare {
+  int rank = 0, ranks = 1;
+};
+State read_particles_csv(const std::filesystem::path& path, int material, double default_density, RowShare share = {});
 // Adds `body,qw,qx,qy,qz` (body index, its orientation; -1 and identity for a free sphere)
 // when the state holds clumps. Split over ranks (collective): one file of every rank's grains,
 // rank after rank.

@@ -305,29 +305,17 @@ MigratingHistories migrating_histories(const State& s, const std::vector<int>& t
                                        const std::vector<std::int32_t>& leaving_index, std::size_t leaving_count) {
   MigratingHistories h;
   h.leaving.resize(leaving_count);
-  const NeighbourList& nl = s.neighbours;
   const std::size_t owned = s.owned();
   const auto keep = [&](std::size_t i, const CarriedPair& c) {
     if (to[i] == rank) h.staying.push_back(c);
     else h.leaving[std::size_t(leaving_index[i])].push_back(c);
   };
-  if (nl.row_start.size() != s.size() + 1) {
-    const IdIndex index(s, owned);
-    for (const CarriedPair& c : s.carried_pairs)
-      if (const std::int64_t i = index.find(c.id); i >= 0) keep(std::size_t(i), c);
-    return h;
-  }
-  for (std::size_t i = 0; i < owned; ++i)
-    for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p) {
-      const Vec3 t = nl.tangential.empty() ? Vec3::Zero() : nl.tangential[std::size_t(p)];
-      const Vec3 r = nl.rolling.empty() ? Vec3::Zero() : nl.rolling[std::size_t(p)];
-      if (t.squaredNorm() == 0 && r.squaredNorm() == 0) continue;
-      const std::size_t j = std::size_t(nl.partner[std::size_t(p)]);
-      const bool both_stay = to[i] == rank && j < owned && to[j] == rank;
-      if (both_stay) continue;
-      keep(i, {s.id[i], s.id[j], t, r});
-      if (j < owned) keep(j, {s.id[j], s.id[i], -t, -r});  // the partner's own view
-    }
+  for_each_history(s, [&](std::size_t i, std::int64_t j, const CarriedPair& c) {
+    const bool partner_owned = j >= 0 && std::size_t(j) < owned;
+    if (to[i] == rank && partner_owned && to[std::size_t(j)] == rank) return;  // both stay: it stays in the list
+    keep(i, c);
+    if (partner_owned) keep(std::size_t(j), other_view(c));
+  });
   return h;
 }
 

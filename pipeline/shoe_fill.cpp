@@ -190,11 +190,13 @@ std::optional<SettledShoe> fill_and_settle_shoe(const PipelineScene& s, const Fi
     fs::create_directories(walls.cache);
     dem::with_whole_state(settled->state, [&](const dem::State& whole) { dem::write_particles_csv(whole, file); });
   }
-  // Every run, cached or not, split or not, starts from the file's numbers.
+  // Every run, cached or not, split or not, starts from the file's numbers; split, each rank reads
+  // its share of them (the grains share_of would keep).
+  const dem::RowShare share = ranks ? dem::RowShare{ranks->rank(), ranks->ranks()} : dem::RowShare{};
   dem::run_and_agree(ranks.get(), true, [&] {
-    out.state = dem::read_particles_csv(file, walls.powder, walls.spec.materials[std::size_t(walls.powder)].density);
+    out.state = dem::read_particles_csv(file, walls.powder, walls.spec.materials[std::size_t(walls.powder)].density, share);
   });
-  out.state = dem::share_of(std::move(out.state), ranks);
+  out.state.exchange = ranks;
   out.requested = grains.count;
   out.inserted = std::size_t(ranks ? ranks->sum(std::int64_t(out.state.size())) : std::int64_t(out.state.size()));
   rest(out.state);
