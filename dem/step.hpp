@@ -26,9 +26,10 @@ struct StepReport {
 
 // Neighbour list and forces for the current positions; call once before stepping.
 void initialize(const Model& model, State& state);
-// Advances one step. Nothing throws inside the loop: a failed check returns its status. A step
-// checks the state it started from (the step before's overlaps, and its energy every few hundred
-// steps) with the one collective it makes when split, so that a failure is reported one step late.
+// Advances one step. Nothing throws inside the loop: a failed check returns its status. Split over
+// ranks, a step checks the state it started from (the step before's overlaps, and its energy every
+// few hundred steps) with the one collective it makes, so that a failure is reported one step
+// late; a single process checks the step's own state.
 StepReport step(const Model& model, State& state, StageTimes* times = nullptr);
 // The checks of the last step taken, which the next step would make: for the end of a run.
 // Collective when split.
