@@ -139,7 +139,7 @@ Agreed agree(State& s, const std::vector<double>& local) {
   return g;
 }
 
-// The checks of the state at `time` (step `step`), from the agreed values.
+// The checks of the state at `time`, from the agreed values.
 StepReport check(const Model& model, State& s, const Agreed& g, bool energy_due, double time) {
   StepReport r;
   s.counters.checked_overlap_rel = g.overlap;
