@@ -93,9 +93,8 @@ class Exchange {
   virtual void reordered(const std::vector<std::int32_t>& new_index) = 0;
   // Every step without a rebuild: the ghosts' positions and velocities, from their owners.
   virtual void update_ghosts(State& state) = 0;
-  // What this rank sends in one update_ghosts [bytes], and in how many messages.
+  // What this rank sends in one update_ghosts [bytes].
   virtual std::size_t ghost_bytes_per_step() const = 0;
-  virtual std::size_t ghost_messages_per_step() const = 0;
   // What the exchange knows between two rebuilds (its subdomains, whom it sends which ghosts), for
   // a checkpoint resumed on the same rank count (dem/checkpoint.cpp): put, then restored as it was.
   virtual std::vector<char> saved() const = 0;

@@ -3,6 +3,7 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <array>
 #include <exception>
 #include <limits>
 #include <stdexcept>
@@ -74,11 +75,6 @@ class MpiExchange final : public Exchange {
     for (const auto& list : send_) grains += list.size();
     return grains * sizeof(GhostMotion);
   }
-  std::size_t ghost_messages_per_step() const override {
-    std::size_t messages = 0;
-    for (const auto& list : send_) messages += list.empty() ? 0 : 1;
-    return messages;
-  }
   std::vector<char> saved() const override;
   void restore(const char* bytes, std::size_t size) override;
 
@@ -127,6 +123,10 @@ class MpiExchange final : public Exchange {
   // From the step's agree(): the heaviest rank's work and the mean, for the rebuild it may call.
   bool agreed_ = false;
   double heaviest_ = 0, mean_ = 0;
+  // This rank's work (work_of), the same from one build to the next: weighed at the first agree
+  // after a migration (keyed by the list's build count and sizes), not in every step's.
+  double work_ = 0;
+  std::array<std::int64_t, 3> work_of_list_{-1, -1, -1};
   std::int64_t collectives_ = 0, cut_count_ = 0, messages_sent_ = 0, bytes_sent_ = 0;
 };
 
@@ -148,8 +148,10 @@ std::vector<double> MpiExchange::all_gather(const std::vector<double>& local) {
 }
 
 std::vector<double> MpiExchange::agree(const State& s, const std::vector<double>& local) {
+  const std::array<std::int64_t, 3> list{s.neighbours.builds, std::int64_t(s.owned()), std::int64_t(s.neighbours.row_start.size())};
+  if (list != work_of_list_) work_ = work_of(s), work_of_list_ = list;
   std::vector<double> mine = local;
-  mine.push_back(work_of(s));
+  mine.push_back(work_);
   const std::vector<double> all = all_gather(mine);
   const std::size_t k = mine.size();
   std::vector<double> theirs;
@@ -353,6 +355,7 @@ void MpiExchange::migrate(State& s) {
     for (double w : work) mean_ += w / ranks_;
   }
   agreed_ = false;
+  work_of_list_ = {-1, -1, -1};  // the grains change here: weighed afresh at the next agree
   recut_ = cuts_.empty() || !listed || heaviest_ > 1.2 * mean_;
   if (recut_) cuts_.cut(weighted_points(s)), ++cut_count_;
 
