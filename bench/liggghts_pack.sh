@@ -1,8 +1,8 @@
-# Sourced by the benchmarks (compare_liggghts.sh, scaling.sh) with $root and $size (5k or 50k)
-# set: installs what the reference scene of ../shared/bench/liggghts needs, builds diefill,
-# prepares the container STLs and the settled pack (by LIGGGHTS, once; kept under
+# Sourced by the benchmarks (compare_liggghts.sh, compare_lammps.sh, scaling.sh, ...) with $root
+# and $size (5k or 50k) set: installs what the reference scene of ../shared/bench/liggghts needs,
+# builds diefill, prepares the container STLs and the settled pack (by LIGGGHTS, once; kept under
 # out/bench/liggghts/runs), and leaves the shell in that work folder with R, H, N, tag set and
-# liggghts_rate defined.
+# liggghts_rate and diefill_rates defined.
 ref="${DIEFILL_LIGGGHTS_DIR:-$root/../shared/bench/liggghts}"
 work="${DIEFILL_BENCH_WORK:-$root/out/bench/liggghts}"
 for p in liggghts openscad mpirun; do
@@ -33,4 +33,18 @@ liggghts_rate() {  # STL [launcher...]
   loop=$("$@" liggghts -in in/bench.in -var wallfile in/wall_mesh.in -var stl "$stl" -var R $R \
            -var state runs/$tag.packed.restart -var nsteps "$steps" | awk '/^Loop time/ {print $4}')
   python3 -c "print($N*$steps/$loop)"
+}
+
+# diefill's particle-steps per second over $steps steps of the same pack in the container STL, on
+# one and two threads (`diefill bench liggghts`, its JSON kept as given): appends the rows
+# "REPEAT,diefill,THREADS,RATE" to the CSV given.
+diefill_rates() {  # REPEAT CSV JSON
+  local k=$1 csv=$2 json=$3
+  "$root/build/diefill" bench liggghts --pack runs/$tag.packed.dump --stl stl/$tag.stl --steps "$steps" \
+    --threads 1 --threads 2 --cache "$work/cache" --json "$json" 2>/dev/null
+  python3 - "$json" "$k" >> "$csv" <<'PY'
+import json, sys
+for run in json.load(open(sys.argv[1]))["cases"][0]["runs"]:
+    print(f'{sys.argv[2]},diefill,{run["threads"]},{run["particle_steps_per_s"]}')
+PY
 }

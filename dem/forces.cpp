@@ -1,8 +1,13 @@
 #include "dem/forces.hpp"
 
 #include <omp.h>
+#if defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512BW__)
+#include <immintrin.h>
+#define DIEFILL_PAIR_TEST_AVX512 1
+#endif
 
 #include <algorithm>
+#include <bit>
 #include <utility>
 #include <vector>
 
@@ -62,8 +67,8 @@ template <class Law, bool Common>
     c.v_rel = Vec3(b.vix[k], b.viy[k], b.viz[k]) - wi.cross(arm_i * c.n) - (Vec3(b.vjx[k], b.vjy[k], b.vjz[k]) + wj.cross(arm_j * c.n));
     c.w_rel = wi - wj;
     ContactHistory h;
-    h.tangential = Vec3(b.tx[k], b.ty[k], b.tz[k]);
-    h.rolling = Vec3(b.rx[k], b.ry[k], b.rz[k]);
+    if constexpr (Law::tangential_history) h.tangential = Vec3(b.tx[k], b.ty[k], b.tz[k]);
+    if constexpr (Law::rolling_history) h.rolling = Vec3(b.rx[k], b.ry[k], b.rz[k]);
     const ContactForce cf = Law::eval(p, c, dt, h);
     // Contact point at -arm_i n from i and +arm_j n from j: torques -arm n x F on both.
     const Vec3 moment = c.n.cross(cf.force);
@@ -71,8 +76,8 @@ template <class Law, bool Common>
     b.fx[k] = cf.force.x(), b.fy[k] = cf.force.y(), b.fz[k] = cf.force.z();
     b.tix[k] = ti.x(), b.tiy[k] = ti.y(), b.tiz[k] = ti.z();
     b.tjx[k] = tj.x(), b.tjy[k] = tj.y(), b.tjz[k] = tj.z();
-    b.tx[k] = h.tangential.x(), b.ty[k] = h.tangential.y(), b.tz[k] = h.tangential.z();
-    b.rx[k] = h.rolling.x(), b.ry[k] = h.rolling.y(), b.rz[k] = h.rolling.z();
+    if constexpr (Law::tangential_history) b.tx[k] = h.tangential.x(), b.ty[k] = h.tangential.y(), b.tz[k] = h.tangential.z();
+    if constexpr (Law::rolling_history) b.rx[k] = h.rolling.x(), b.ry[k] = h.rolling.y(), b.rz[k] = h.rolling.z();
     b.overlap_rel[k] = c.overlap / std::min(ri, rj);
   }
 }
@@ -87,26 +92,28 @@ std::pair<std::size_t, std::size_t> static_range(std::size_t n) {
   return {begin, begin + share + (t < extra ? 1 : 0)};
 }
 
-// Blocks in parallel (state.hpp, NeighbourList): a thread takes whole blocks, sets their grains'
-// forces to gravity, then goes through their rows in order, gathering the touching pairs into a
-// batch, evaluating it, and adding the results in row and pair order: to the row's grain, and to
-// its partner directly when the partner is in the same block, else to the cross pair's buffer.
-// Every grain's force is thus gravity, the shares of lower rows of its block in row order, its
-// own pairs in order, then (sum_forces) the cross shares in pair order: the same sums, bit for
-// bit, whatever the thread count.
 // A batch's results added in row and pair order: to the row's grain, to its partner when in
-// the same block (slot < 0), else to the cross pair's buffer; histories written back. Returns
-// the largest overlap over the smaller radius.
-double apply_batch(const ContactBatch& b, State& s, bool tangential, bool rolling) {
+// the same block (slot < 0), else to the cross pair's buffer; histories written back. The row's
+// grain adds its contacts in a register, stored when the row changes: the same additions in the
+// same order as through memory (a partner is always a later grain than its row). Returns the
+// largest overlap over the smaller radius.
+template <class Law>
+double apply_batch(const ContactBatch& b, State& s) {
   NeighbourList& nl = s.neighbours;
   Vec3* const f = s.f.data();
   Vec3* const torque = s.torque.data();
   double max_overlap = 0;
+  std::size_t row = std::size_t(b.row[0]);
+  Vec3 row_force = f[row], row_torque = torque[row];
   for (int k = 0; k < b.size; ++k) {
     const std::size_t i = std::size_t(b.row[k]), p = std::size_t(b.pair[k]);
+    if (i != row) {
+      f[row] = row_force, torque[row] = row_torque;
+      row = i, row_force = f[i], row_torque = torque[i];
+    }
     const Vec3 force(b.fx[k], b.fy[k], b.fz[k]), partner_torque(b.tjx[k], b.tjy[k], b.tjz[k]);
-    f[i] += force;
-    torque[i] += Vec3(b.tix[k], b.tiy[k], b.tiz[k]);
+    row_force += force;
+    row_torque += Vec3(b.tix[k], b.tiy[k], b.tiz[k]);
     if (b.slot[k] < 0) {
       const std::size_t j = std::size_t(b.partner[k]);
       f[j] += -force;
@@ -115,11 +122,71 @@ double apply_batch(const ContactBatch& b, State& s, bool tangential, bool rollin
       s.cross_forces.force[std::size_t(b.slot[k])] = -force;
       s.cross_forces.torque[std::size_t(b.slot[k])] = partner_torque;
     }
-    if (tangential) nl.tangential[p] = Vec3(b.tx[k], b.ty[k], b.tz[k]);
-    if (rolling) nl.rolling[p] = Vec3(b.rx[k], b.ry[k], b.rz[k]);
+    if constexpr (Law::tangential_history) nl.tangential[p] = Vec3(b.tx[k], b.ty[k], b.tz[k]);
+    if constexpr (Law::rolling_history) nl.rolling[p] = Vec3(b.rx[k], b.ry[k], b.rz[k]);
     max_overlap = std::max(max_overlap, b.overlap_rel[k]);
   }
+  f[row] = row_force, torque[row] = row_torque;
   return max_overlap;
+}
+
+// Up to eight consecutive listed pairs of one row tested for contact at once (lanes = how many):
+// bit k of `touching` is set when pair k touches, of `cross` when its partner lies at or beyond
+// `block_end` (the pair's share then goes through a buffer); the separations x_i - x_j and the
+// partners' radii are kept for the contacts' batch. The test is the single pair's, operation for
+// operation: not (d_x² + (d_y² + d_z²) >= (r_i + r_j)²), Eigen's order of the squared norm, so
+// that the same pairs touch with or without the vector instructions, and a non-finite separation
+// counts as a contact (the overlap check then stops the run). With AVX-512 the eight partners are
+// gathered and compared in one pass: the scalar test, a load-compare-branch per listed pair, was
+// the largest part of the pair stage (about half of the listed pairs are apart).
+struct PairTest {
+  std::uint32_t touching = 0, cross = 0;
+  alignas(64) double dx[8], dy[8], dz[8], rj[8];
+};
+
+inline void test_pairs(PairTest& t, const Vec3& xi, double ri, const std::int32_t* partner, int lanes, const Vec3* x,
+                       const double* radius, std::int32_t block_end) {
+#ifdef DIEFILL_PAIR_TEST_AVX512
+  const auto live = __mmask8((1u << lanes) - 1);
+  const __m256i j = _mm256_maskz_loadu_epi32(live, partner);
+  const __m512i j64 = _mm512_cvtepi32_epi64(j);
+  const __m512i coordinate = _mm512_add_epi64(j64, _mm512_add_epi64(j64, j64));  // x[j] is 3 doubles
+  const double* const xd = x->data();
+  const __m512d zero = _mm512_setzero_pd();
+  const __m512d dx = _mm512_sub_pd(_mm512_set1_pd(xi.x()), _mm512_mask_i64gather_pd(zero, live, coordinate, xd, 8));
+  const __m512d dy = _mm512_sub_pd(_mm512_set1_pd(xi.y()), _mm512_mask_i64gather_pd(zero, live, coordinate, xd + 1, 8));
+  const __m512d dz = _mm512_sub_pd(_mm512_set1_pd(xi.z()), _mm512_mask_i64gather_pd(zero, live, coordinate, xd + 2, 8));
+  const __m512d rj = _mm512_mask_i64gather_pd(zero, live, j64, radius, 8);
+  const __m512d d2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_add_pd(_mm512_mul_pd(dy, dy), _mm512_mul_pd(dz, dz)));
+  const __m512d reach = _mm512_add_pd(_mm512_set1_pd(ri), rj);
+  t.touching = _mm512_mask_cmp_pd_mask(live, d2, _mm512_mul_pd(reach, reach), _CMP_NGE_UQ);
+  t.cross = _mm256_mask_cmpge_epi32_mask(live, j, _mm256_set1_epi32(block_end));
+  _mm512_store_pd(t.dx, dx), _mm512_store_pd(t.dy, dy), _mm512_store_pd(t.dz, dz), _mm512_store_pd(t.rj, rj);
+#else
+  t.touching = t.cross = 0;
+  for (int k = 0; k < lanes; ++k) {
+    const std::int32_t j = partner[k];
+    const Vec3 d = xi - x[j];
+    const double reach = ri + radius[j];
+    t.dx[k] = d.x(), t.dy[k] = d.y(), t.dz[k] = d.z(), t.rj[k] = radius[j];
+    t.touching |= std::uint32_t(!(d.squaredNorm() >= reach * reach)) << k;
+    t.cross |= std::uint32_t(j >= block_end) << k;
+  }
+#endif
+}
+
+// The touching flags of `lanes` pairs from `flags`, as bits, and the new ones written.
+inline std::uint32_t swap_touching(std::uint8_t* flags, int lanes, std::uint32_t now) {
+#ifdef DIEFILL_PAIR_TEST_AVX512
+  const auto live = __mmask16((1u << lanes) - 1);
+  const __m128i old = _mm_maskz_loadu_epi8(live, flags);
+  _mm_mask_storeu_epi8(flags, live, _mm_maskz_set1_epi8(__mmask16(now), 1));
+  return _mm_test_epi8_mask(old, old);
+#else
+  std::uint32_t was = 0;
+  for (int k = 0; k < lanes; ++k) was |= std::uint32_t(flags[k] != 0) << k, flags[k] = std::uint8_t(now >> k & 1u);
+  return was;
+#endif
 }
 
 // Blocks in parallel (state.hpp, NeighbourList): a thread takes whole blocks, sets their grains'
@@ -134,7 +201,6 @@ template <class Law>
 void pair_forces(const Model& model, State& s) {
   NeighbourList& nl = s.neighbours;
   const double dt = model.dt;
-  const bool tangential = !nl.tangential.empty(), rolling = !nl.rolling.empty();
   double max_overlap = 0;
   std::int64_t contacts = 0;
   const PairParams* common = model.materials.size() == 1 ? &model.params(0, 0) : nullptr;
@@ -147,8 +213,6 @@ void pair_forces(const Model& model, State& s) {
   const double* const mass = s.mass.data();
   const std::int32_t* const partner = nl.partner.data();
   std::uint8_t* const touching = nl.touching.data();
-  const std::int32_t pairs_end = std::int32_t(nl.partner.size());
-  constexpr std::int32_t prefetch_distance = 6;
 #pragma omp parallel reduction(max : max_overlap) reduction(+ : contacts)
   {
     static thread_local ContactBatch batch;
@@ -160,7 +224,7 @@ void pair_forces(const Model& model, State& s) {
       b.size = count;
       if (common) evaluate<Law, true>(b, dt, *common);
       else evaluate<Law, false>(b, dt, PairParams{});
-      largest = std::max(largest, apply_batch(b, s, tangential, rolling));
+      if (count > 0) largest = std::max(largest, apply_batch<Law>(b, s));
       evaluated += count;
       count = 0;
     };
@@ -179,51 +243,52 @@ void pair_forces(const Model& model, State& s) {
         const int mat_i = s.material[i];
         std::int32_t cross_slot = nl.cross_start[i];
         const std::int32_t row_end = nl.row_start[i + 1];
-        for (std::int32_t p = nl.row_start[i]; p < row_end; ++p) {
-          const std::size_t j = std::size_t(partner[p]);
-          // The partner a few pairs ahead is fetched while this one is computed: the loop waits on
-          // its partners' data, not on arithmetic, once the grains outgrow the first-level cache.
-          if (p + prefetch_distance < pairs_end) {
-            const std::size_t ahead = std::size_t(partner[p + prefetch_distance]);
-            __builtin_prefetch(&x[ahead]);
-            __builtin_prefetch(&v[ahead]);
-            __builtin_prefetch(&w[ahead]);
-            __builtin_prefetch(&radius[ahead]);
+        for (std::int32_t first = nl.row_start[i]; first < row_end; first += 8) {
+          const int lanes = std::min(8, row_end - first);
+          PairTest t;
+          test_pairs(t, xi, ri, partner + first, lanes, x, radius, std::int32_t(hi));
+          // The cross slot of lane k: the row's next one plus the cross lanes before it.
+          const auto slot_of = [&](int k) {
+            return t.cross >> k & 1u ? cross_slot + std::popcount(t.cross & ((1u << k) - 1)) : -1;
+          };
+          // A contact that just ended clears its history and its share; most listed pairs were
+          // apart already and cost only their flag.
+          for (std::uint32_t ended = swap_touching(touching + first, lanes, t.touching) & ~t.touching; ended; ended &= ended - 1) {
+            const int k = std::countr_zero(ended);
+            const auto p = std::size_t(first + k);
+            if constexpr (Law::tangential_history) nl.tangential[p].setZero();
+            if constexpr (Law::rolling_history) nl.rolling[p].setZero();
+            if (const std::int32_t slot = slot_of(k); slot >= 0)
+              s.cross_forces.force[std::size_t(slot)].setZero(), s.cross_forces.torque[std::size_t(slot)].setZero();
           }
-          const std::int32_t slot = j < hi ? -1 : cross_slot++;
-          const Vec3 d = xi - x[j];
-          const double reach = ri + radius[j];
-          // Lists hold active grains only: grains are lost at rebuilds, which rebuild the lists.
-          if (d.squaredNorm() >= reach * reach) {
-            // A contact that just ended clears its history and its share; most listed pairs
-            // were apart already and cost only this flag.
-            if (touching[p]) {
-              touching[p] = 0;
-              if (tangential) nl.tangential[std::size_t(p)].setZero();
-              if (rolling) nl.rolling[std::size_t(p)].setZero();
-              if (slot >= 0) s.cross_forces.force[std::size_t(slot)].setZero(), s.cross_forces.torque[std::size_t(slot)].setZero();
+          for (std::uint32_t hits = t.touching; hits; hits &= hits - 1) {
+            const int lane = std::countr_zero(hits);
+            const std::int32_t p = first + lane;
+            const auto j = std::size_t(partner[p]);
+            if (count == ContactBatch::capacity) flush();
+            const int k = count++;
+            const Vec3 vj = v[j], wj = w[j];
+            b.pair[k] = p, b.row[k] = std::int32_t(i), b.partner[k] = std::int32_t(j), b.slot[k] = slot_of(lane);
+            b.dx[k] = t.dx[lane], b.dy[k] = t.dy[lane], b.dz[k] = t.dz[lane];
+            b.ri[k] = ri, b.rj[k] = t.rj[lane], b.mi[k] = mi, b.mj[k] = mass[j];
+            b.vix[k] = vi.x(), b.viy[k] = vi.y(), b.viz[k] = vi.z(), b.wix[k] = wi.x(), b.wiy[k] = wi.y(), b.wiz[k] = wi.z();
+            b.vjx[k] = vj.x(), b.vjy[k] = vj.y(), b.vjz[k] = vj.z(), b.wjx[k] = wj.x(), b.wjy[k] = wj.y(), b.wjz[k] = wj.z();
+            if constexpr (Law::tangential_history) {
+              const Vec3& h = nl.tangential[std::size_t(p)];
+              b.tx[k] = h.x(), b.ty[k] = h.y(), b.tz[k] = h.z();
             }
-            continue;
+            if constexpr (Law::rolling_history) {
+              const Vec3& h = nl.rolling[std::size_t(p)];
+              b.rx[k] = h.x(), b.ry[k] = h.y(), b.rz[k] = h.z();
+            }
+            if (!common) {
+              const PairParams& pp = model.params(mat_i, s.material[j]);
+              b.e_star[k] = pp.e_star, b.damping[k] = pp.damping, b.mu_s[k] = pp.mu_s, b.mu_r[k] = pp.mu_r;
+              b.k_linear[k] = pp.k_linear, b.kt_over_kn[k] = pp.kt_over_kn, b.sqrt_kt_over_kn[k] = pp.sqrt_kt_over_kn;
+              b.cohesion[k] = pp.cohesion;
+            }
           }
-          if (!touching[p]) touching[p] = 1;
-          if (count == ContactBatch::capacity) flush();
-          const int k = count++;
-          const Vec3 vj = v[j], wj = w[j];
-          const Vec3 t = tangential ? nl.tangential[std::size_t(p)] : Vec3::Zero();
-          const Vec3 r = rolling ? nl.rolling[std::size_t(p)] : Vec3::Zero();
-          b.pair[k] = p, b.row[k] = std::int32_t(i), b.partner[k] = std::int32_t(j), b.slot[k] = slot;
-          b.dx[k] = d.x(), b.dy[k] = d.y(), b.dz[k] = d.z();
-          b.ri[k] = ri, b.rj[k] = radius[j], b.mi[k] = mi, b.mj[k] = mass[j];
-          b.vix[k] = vi.x(), b.viy[k] = vi.y(), b.viz[k] = vi.z(), b.wix[k] = wi.x(), b.wiy[k] = wi.y(), b.wiz[k] = wi.z();
-          b.vjx[k] = vj.x(), b.vjy[k] = vj.y(), b.vjz[k] = vj.z(), b.wjx[k] = wj.x(), b.wjy[k] = wj.y(), b.wjz[k] = wj.z();
-          b.tx[k] = t.x(), b.ty[k] = t.y(), b.tz[k] = t.z();
-          b.rx[k] = r.x(), b.ry[k] = r.y(), b.rz[k] = r.z();
-          if (!common) {
-            const PairParams& pp = model.params(mat_i, s.material[j]);
-            b.e_star[k] = pp.e_star, b.damping[k] = pp.damping, b.mu_s[k] = pp.mu_s, b.mu_r[k] = pp.mu_r;
-            b.k_linear[k] = pp.k_linear, b.kt_over_kn[k] = pp.kt_over_kn, b.sqrt_kt_over_kn[k] = pp.sqrt_kt_over_kn;
-            b.cohesion[k] = pp.cohesion;
-          }
+          cross_slot += std::popcount(t.cross);
         }
       }
       // A block's results are complete before the next block's grains are set to gravity.
