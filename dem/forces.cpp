@@ -149,7 +149,7 @@ inline void test_pairs(PairTest& t, const Vec3& xi, double ri, const std::int32_
 #ifdef DIEFILL_PAIR_TEST_AVX512
   const auto live = __mmask8((1u << lanes) - 1);
   const __m256i j = _mm256_maskz_loadu_epi32(live, partner);
-  const __m512i j64 = _mm512_cvtepi32_epi64(j);
+  const __m512i j64 = _mm512_maskz_cvtepi32_epi64(live, j);  // maskz: the plain form warns of an undefined source (GCC 12)
   const __m512i coordinate = _mm512_add_epi64(j64, _mm512_add_epi64(j64, j64));  // x[j] is 3 doubles
   const double* const xd = x->data();
   const __m512d zero = _mm512_setzero_pd();
@@ -309,8 +309,11 @@ template <class Law>
   const double dt = model.dt;
   double max_overlap = s.counters.max_overlap_rel;
   std::int64_t contacts = 0;
+  // Only a moving wall does work (planes stand still): with none, every share is zero and the
+  // serial sum below, a pass over every near-wall grain, is left out (the same 0 it would give).
+  const bool walls_move = std::find(model.mesh_moves.begin(), model.mesh_moves.end(), 1) != model.mesh_moves.end();
   Array<double>& power = s.scratch_wall_power;
-  power.assign(near.size(), 0.0);
+  power.assign(walls_move ? near.size() : 0, 0.0);
   const std::size_t walls = model.meshes.size();
   if (s.wall_candidates.size() != near.size() * walls) s.wall_candidates.assign(near.size() * walls, WallCandidates{});
 #pragma omp parallel for schedule(static) reduction(max : max_overlap) reduction(+ : contacts)
@@ -359,7 +362,7 @@ template <class Law>
       const ContactForce cf = Law::eval(model.params(s.material[i], wall_material), c, dt, next[k].history);
       s.f[i] += cf.force;
       s.torque[i] += -arm * c.n.cross(cf.force) + cf.rolling_torque;
-      power[q] += cf.force.dot(hit.wall_velocity);
+      if (walls_move) power[q] += cf.force.dot(hit.wall_velocity);
       if (c.overlap > max_overlap * s.radius[i]) max_overlap = c.overlap / s.radius[i];
       ++contacts;
     }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <limits>
 #include <numeric>
+#include <parallel/algorithm>
 
 #include "dem/distributed.hpp"
 #include "dem/walls.hpp"
@@ -33,10 +34,17 @@ struct CellGrid {
 // no smaller than the interaction reach and no more cells than a few per grain.
 CellGrid make_grid(const Model& model, const State& s) {
   CellGrid g;
-  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  double lo_x = std::numeric_limits<double>::infinity(), lo_y = lo_x, lo_z = lo_x, hi_x = -lo_x, hi_y = -lo_x, hi_z = -lo_x;
   std::size_t active = 0;
+#pragma omp parallel for schedule(static) reduction(min : lo_x, lo_y, lo_z) reduction(max : hi_x, hi_y, hi_z) reduction(+ : active)
   for (std::size_t i = 0; i < s.size(); ++i)
-    if (s.active[i]) lo = lo.cwiseMin(s.x[i]), hi = hi.cwiseMax(s.x[i]), ++active;
+    if (s.active[i]) {
+      const Vec3& x = s.x[i];
+      lo_x = std::min(lo_x, x.x()), lo_y = std::min(lo_y, x.y()), lo_z = std::min(lo_z, x.z());
+      hi_x = std::max(hi_x, x.x()), hi_y = std::max(hi_y, x.y()), hi_z = std::max(hi_z, x.z());
+      ++active;
+    }
+  Vec3 lo(lo_x, lo_y, lo_z), hi(hi_x, hi_y, hi_z);
   if (active == 0) lo = hi = Vec3::Zero();
   g.origin = lo;
   g.size = model.cell_size;
@@ -47,17 +55,26 @@ CellGrid make_grid(const Model& model, const State& s) {
   const std::size_t cells = std::size_t(g.dims[0]) * std::size_t(g.dims[1]) * std::size_t(g.dims[2]);
   g.start.assign(cells + 1, 0);
   std::vector<std::size_t> cell(s.size());
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    if (!s.active[i]) continue;
-    cell[i] = g.cell_of(s.x[i]);
-    ++g.start[cell[i] + 1];
-  }
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (s.active[i]) cell[i] = g.cell_of(s.x[i]);
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (s.active[i]) ++g.start[cell[i] + 1];
   for (std::size_t c = 0; c < cells; ++c) g.start[c + 1] += g.start[c];
   g.members.resize(std::size_t(g.start[cells]));
   std::vector<std::int32_t> fill(g.start.begin(), g.start.end() - 1);
   for (std::size_t i = 0; i < s.size(); ++i)
     if (s.active[i]) g.members[std::size_t(fill[cell[i]]++)] = std::int32_t(i);
   return g;
+}
+
+// The grid of the particles after sort_particles, from the one before it: the cells keep their
+// grains (positions do not move), each member renamed. A cell's members stay ascending: its active
+// owned grains share one Morton key, sorted by their old index, and its ghosts keep their order
+// after every owned grain.
+void rename_members(CellGrid& g, const std::vector<std::int32_t>& new_index) {
+#pragma omp parallel for schedule(static)
+  for (std::size_t m = 0; m < g.members.size(); ++m) g.members[m] = new_index[std::size_t(g.members[m])];
 }
 
 // Applies `order` (new index -> old index) to every per-particle array, through a scratch array
@@ -70,7 +87,10 @@ void permute(Values& a, const std::vector<std::int32_t>& order) {
   // with the scratch).
   if (scratch.capacity() < order.size()) scratch.clear(), scratch.reserve(order.size());
   scratch.resize(order.size());
-  for (std::size_t n = 0; n < order.size(); ++n) scratch[n] = a[std::size_t(order[n])];
+  auto* const out = scratch.data();
+  const auto* const in = a.data();
+#pragma omp parallel for schedule(static)
+  for (std::size_t n = 0; n < order.size(); ++n) out[n] = in[std::size_t(order[n])];
   a.swap(scratch);
 }
 
@@ -92,14 +112,18 @@ std::uint64_t morton(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
 // Active owned particles along the Morton curve of their cells (ties in index order), lost ones
 // after them in their old order, then the ghosts as they came. new_index: old index -> new.
 std::vector<std::int32_t> sort_particles(State& s, const CellGrid& g, std::vector<std::int32_t>& new_index) {
-  std::vector<std::pair<std::uint64_t, std::int32_t>> keyed;
-  keyed.reserve(s.size());
+  // Keys of the active owned grains in index order (a prefix count places each), then sorted in
+  // parallel: the keys are unique (index as tie-break), so every sort gives the same order.
+  std::vector<std::int32_t> slot(s.owned() + 1, 0);
+  for (std::size_t i = 0; i < s.owned(); ++i) slot[i + 1] = slot[i] + (s.active[i] ? 1 : 0);
+  std::vector<std::pair<std::uint64_t, std::int32_t>> keyed(std::size_t(slot[s.owned()]));
+#pragma omp parallel for schedule(static)
   for (std::size_t i = 0; i < s.owned(); ++i)
     if (s.active[i])
-      keyed.push_back({morton(std::uint32_t(g.cell_coord(s.x[i].x(), 0)), std::uint32_t(g.cell_coord(s.x[i].y(), 1)),
-                              std::uint32_t(g.cell_coord(s.x[i].z(), 2))),
-                       std::int32_t(i)});
-  std::sort(keyed.begin(), keyed.end());
+      keyed[std::size_t(slot[i])] = {morton(std::uint32_t(g.cell_coord(s.x[i].x(), 0)), std::uint32_t(g.cell_coord(s.x[i].y(), 1)),
+                                            std::uint32_t(g.cell_coord(s.x[i].z(), 2))),
+                                     std::int32_t(i)};
+  __gnu_parallel::sort(keyed.begin(), keyed.end());
   std::vector<std::int32_t> order;
   order.reserve(s.size());
   for (const auto& [key, i] : keyed) order.push_back(i);
@@ -107,6 +131,7 @@ std::vector<std::int32_t> sort_particles(State& s, const CellGrid& g, std::vecto
     if (!s.active[i]) order.push_back(std::int32_t(i));
   for (std::size_t i = s.owned(); i < s.size(); ++i) order.push_back(std::int32_t(i));
   new_index.assign(s.size(), -1);
+#pragma omp parallel for schedule(static)
   for (std::size_t n = 0; n < order.size(); ++n) new_index[std::size_t(order[n])] = std::int32_t(n);
   permute(s.id, order);
   permute(s.x, order);
@@ -130,6 +155,7 @@ void carry_wall_slots(State& s, const Array<std::int32_t>& old_near, const Array
                       const std::vector<std::int32_t>& order) {
   const Array<std::int32_t>& near = s.neighbours.near_wall;
   s.wall_slots.assign(near.size() * wall_slots_per_particle, WallSlot{});
+#pragma omp parallel for schedule(static)
   for (std::size_t q = 0; q < near.size(); ++q) {
     const std::int32_t old_i = order[std::size_t(near[q])];
     const auto at = std::lower_bound(old_near.begin(), old_near.end(), old_i);
@@ -281,7 +307,7 @@ void rebuild_neighbours(const Model& model, State& s) {
   std::vector<std::int32_t> new_index;
   const std::vector<std::int32_t> order = sort_particles(s, grid, new_index);
   if (s.exchange) s.exchange->reordered(new_index);
-  grid = make_grid(model, s);  // members now ascending along the cells
+  rename_members(grid, new_index);
   // By row, in a counting sort (linear, stable: within a row the old list's order, the same every
   // run; split over ranks, a pair that met across a subdomain face comes once from each side, the
   // two views agreeing to rounding, and the first is taken).
@@ -308,6 +334,7 @@ void rebuild_neighbours(const Model& model, State& s) {
   {
     std::vector<std::int32_t>& buffer = found[std::size_t(omp_get_thread_num())];
     buffer.reserve(nl.partner.size() / found.size() + 1024);
+    std::vector<std::int32_t> apart;
 #pragma omp for schedule(dynamic, 256)
   for (std::size_t i = 0; i < s.owned(); ++i) {
     if (!s.active[i]) continue;
@@ -331,12 +358,18 @@ void rebuild_neighbours(const Model& model, State& s) {
     // listed pair for contact, and contacts last thousands of steps, so the outcome runs in two
     // predictable stretches per row instead of at random (a mispredicted branch per pair cost
     // about a tenth of the force loop).
+    // (In place, with the apart ones kept aside in the thread's own list: std::stable_partition
+    // allocated a buffer per row.)
     const auto row = buffer.begin() + std::ptrdiff_t(begin);
     std::sort(row, buffer.end());
-    std::stable_partition(row, buffer.end(), [&](std::int32_t j) {
-      const double reach = s.radius[i] + s.radius[std::size_t(j)];
-      return (s.x[std::size_t(j)] - xi).squaredNorm() < reach * reach;
-    });
+    auto kept = row;
+    apart.clear();
+    for (auto it = row; it != buffer.end(); ++it) {
+      const double reach = s.radius[i] + s.radius[std::size_t(*it)];
+      if ((s.x[std::size_t(*it)] - xi).squaredNorm() < reach * reach) *kept++ = *it;
+      else apart.push_back(*it);
+    }
+    std::copy(apart.begin(), apart.end(), kept);
     row_thread[i] = omp_get_thread_num(), row_begin[i] = std::int32_t(begin), row_length[i] = std::int32_t(buffer.size() - begin);
   }
   }
@@ -348,6 +381,7 @@ void rebuild_neighbours(const Model& model, State& s) {
   nl.tangential.assign(tangential ? pairs : 0, Vec3::Zero());
   nl.rolling.assign(rolling ? pairs : 0, Vec3::Zero());
   nl.touching.assign(pairs, 0);
+#pragma omp parallel for schedule(static)
   for (std::size_t i = 0; i < n; ++i) {
     const auto history_begin = old.partner.begin() + old.start[i], history_end = old.partner.begin() + old.start[i + 1];
     const std::int32_t* row = found[std::size_t(row_thread[i])].data() + row_begin[i];

@@ -1,6 +1,9 @@
 #include "dem/walls.hpp"
 
+#include <omp.h>
+
 #include <limits>
+#include <vector>
 
 namespace dem {
 
@@ -74,20 +77,30 @@ double wall_distance(const Model& model, double time, const Vec3& x) {
 }
 
 void collect_near_wall(const Model& model, State& s) {
+  // In parallel: each thread lists the near grains of its own stretch of grains (a static
+  // schedule gives thread t the t-th stretch), and the lists are joined in thread order, so that
+  // the near list is ascending whatever the thread count.
+  std::vector<std::vector<std::int32_t>> found(static_cast<std::size_t>(omp_get_max_threads()));
+#pragma omp parallel
+  {
+    std::vector<std::int32_t>& mine = found[std::size_t(omp_get_thread_num())];
+#pragma omp for schedule(static)
+    for (std::size_t i = 0; i < s.owned(); ++i) {
+      if (!s.active[i]) continue;
+      const double reach = s.radius[i] + model.skin;
+      bool close = false;
+      for (const PlaneWall& plane : model.planes) close |= (s.x[i] - plane.point).dot(plane.normal) < reach;
+      for (const MeshWall& wall : model.meshes) {
+        // Trilinear values are within a voxel of the truth; beyond the band they are ± background.
+        if (close) break;
+        close = wall.field->trilinear(wall.motion.to_local(s.time, s.x[i])) < reach + wall.field->voxel;
+      }
+      if (close) mine.push_back(std::int32_t(i));
+    }
+  }
   Array<std::int32_t>& near = s.neighbours.near_wall;
   near.clear();
-  for (std::size_t i = 0; i < s.owned(); ++i) {
-    if (!s.active[i]) continue;
-    const double reach = s.radius[i] + model.skin;
-    bool close = false;
-    for (const PlaneWall& plane : model.planes) close |= (s.x[i] - plane.point).dot(plane.normal) < reach;
-    for (const MeshWall& wall : model.meshes) {
-      // Trilinear values are within a voxel of the truth; beyond the band they are ± background.
-      if (close) break;
-      close = wall.field->trilinear(wall.motion.to_local(s.time, s.x[i])) < reach + wall.field->voxel;
-    }
-    if (close) near.push_back(std::int32_t(i));
-  }
+  for (const std::vector<std::int32_t>& part : found) near.insert(near.end(), part.begin(), part.end());
   s.wall_candidates.assign(near.size() * model.meshes.size(), WallCandidates{});
 }
 
