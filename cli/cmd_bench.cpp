@@ -92,6 +92,16 @@ dem::State read_lammps_dump(const fs::path& path, const dem::Material& m) {
 }
 
 
+// A line of /proc/self/status in bytes ("VmRSS:", the resident set now; "VmHWM:", its peak
+// since the last reset_resident_peak()); 0 where the file is not there.
+double status_bytes(const std::string& field) {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind(field, 0) == 0) return 1024.0 * std::stod(line.substr(field.size()));  // kB
+  return 0;
+}
+void reset_resident_peak() { std::ofstream("/proc/self/clear_refs") << "5"; }
+
 json time_case(const std::string& name, const dem::Model& model, const dem::State& pack, int steps,
                const std::vector<int>& thread_counts) {
   const std::shared_ptr<dem::Exchange> exchange = mpi_exchange();
@@ -103,6 +113,10 @@ json time_case(const std::string& name, const dem::Model& model, const dem::Stat
   json runs = json::array();
   for (int threads : thread_counts) {
     omp_set_num_threads(threads);
+    // What the run holds at its peak, from its state on: the arrays with the allocator's rounding,
+    // the rebuilds' scratch and the threads' buffers (bytes_per_particle below counts the arrays).
+    reset_resident_peak();
+    const double resident_before = status_bytes("VmRSS:");
     dem::State s = dem::share_of(pack, exchange);
     dem::initialize(model, s);
     // A step that fails its checks ends the benchmark: a rate measured on a failed state (grains
@@ -144,6 +158,7 @@ json time_case(const std::string& name, const dem::Model& model, const dem::Stat
       const double rebuild = rebuild_clock.seconds();
       runs.back()["rebuild_s"] = rebuild;
       runs.back()["rebuild_over_step"] = rebuild / (wall / steps);
+      runs.back()["peak_resident_bytes_per_particle"] = (status_bytes("VmHWM:") - resident_before) / grains;
     }
     diefill::log::info("bench {}: {} threads, {:.3g} particle-steps/s", name, threads, rate);
     if (threads == thread_counts.back()) {
