@@ -74,7 +74,7 @@ struct LinearNormal {
 
 // ---- tangential slot --------------------------------------------------------------------
 struct MindlinTangential {
-  static constexpr bool history = true;  // keeps the spring ξ per pair
+  static constexpr bool active = true;
   // Tangential force on i, updating the spring ξ. S_t = 8 G* sqrt(R* δ) = (4 G*/E*) S_n, damped
   // like the normal part (γ_t = sqrt(S_t/S_n) γ_n); `normal_force` (non-negative) sets the
   // Coulomb cap.
@@ -99,7 +99,7 @@ struct MindlinTangential {
   }
 };
 struct NoTangential {
-  static constexpr bool history = false;
+  static constexpr bool active = false;
   static Vec3 eval(const PairParams&, const ContactKinematics&, double, double, double, double, Vec3&) {
     return Vec3::Zero();
   }
@@ -108,7 +108,7 @@ struct NoTangential {
 // ---- rolling slot -----------------------------------------------------------------------
 // Torque on i opposing the relative rolling; limit μ_r R* F_n.
 struct EpsdRolling {
-  static constexpr bool history = true;  // keeps the elastic torque per pair
+  static constexpr bool active = true;
   // Elastic-plastic spring (Ai et al. 2011, type C without damping): k_r = 2.25 S_n μ_r² R*².
   static Vec3 eval(const PairParams& p, const ContactKinematics& c, double normal_force,
                    double normal_stiffness, double dt, Vec3& torque) {
@@ -123,7 +123,7 @@ struct EpsdRolling {
   }
 };
 struct CdtRolling {
-  static constexpr bool history = false;
+  static constexpr bool active = true;
   // Constant directional torque (LIGGGHTS "cdt"): full limit against the rolling direction.
   static Vec3 eval(const PairParams& p, const ContactKinematics& c, double normal_force, double,
                    double, Vec3&) {
@@ -134,7 +134,7 @@ struct CdtRolling {
   }
 };
 struct NoRolling {
-  static constexpr bool history = false;
+  static constexpr bool active = false;
   static Vec3 eval(const PairParams&, const ContactKinematics&, double, double, double, Vec3&) {
     return Vec3::Zero();
   }
@@ -155,8 +155,6 @@ struct NoCohesion {
 // rolling, in that order.
 template <class Normal, class Tangential, class Rolling, class Cohesion>
 struct ContactLaw {
-  // Which histories the law reads and writes: the pair loop gathers and stores only those.
-  static constexpr bool tangential_history = Tangential::history, rolling_history = Rolling::history;
   static ContactForce eval(const PairParams& p, const ContactKinematics& c, double dt,
                            ContactHistory& h) {
     double elastic, stiffness;

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -16,6 +17,15 @@
 namespace dem {
 
 namespace {
+
+// The histories a law reads and writes, which the pair loop gathers and stores (only those): the
+// Mindlin spring and the EPSD torque; constant directional torque and no law keep none.
+template <class Law>
+struct KeptHistories;
+template <class Normal, class Tangential, class Rolling, class Cohesion>
+struct KeptHistories<ContactLaw<Normal, Tangential, Rolling, Cohesion>> {
+  static constexpr bool tangential = Tangential::active, rolling = std::is_same_v<Rolling, EpsdRolling>;
+};
 
 // Contacts gathered from consecutive rows, as columns (one array per quantity), so that the
 // law runs over them as a loop the compiler vectorises. The columns start on cache lines, so
@@ -67,8 +77,8 @@ template <class Law, bool Common>
     c.v_rel = Vec3(b.vix[k], b.viy[k], b.viz[k]) - wi.cross(arm_i * c.n) - (Vec3(b.vjx[k], b.vjy[k], b.vjz[k]) + wj.cross(arm_j * c.n));
     c.w_rel = wi - wj;
     ContactHistory h;
-    if constexpr (Law::tangential_history) h.tangential = Vec3(b.tx[k], b.ty[k], b.tz[k]);
-    if constexpr (Law::rolling_history) h.rolling = Vec3(b.rx[k], b.ry[k], b.rz[k]);
+    if constexpr (KeptHistories<Law>::tangential) h.tangential = Vec3(b.tx[k], b.ty[k], b.tz[k]);
+    if constexpr (KeptHistories<Law>::rolling) h.rolling = Vec3(b.rx[k], b.ry[k], b.rz[k]);
     const ContactForce cf = Law::eval(p, c, dt, h);
     // Contact point at -arm_i n from i and +arm_j n from j: torques -arm n x F on both.
     const Vec3 moment = c.n.cross(cf.force);
@@ -76,8 +86,8 @@ template <class Law, bool Common>
     b.fx[k] = cf.force.x(), b.fy[k] = cf.force.y(), b.fz[k] = cf.force.z();
     b.tix[k] = ti.x(), b.tiy[k] = ti.y(), b.tiz[k] = ti.z();
     b.tjx[k] = tj.x(), b.tjy[k] = tj.y(), b.tjz[k] = tj.z();
-    if constexpr (Law::tangential_history) b.tx[k] = h.tangential.x(), b.ty[k] = h.tangential.y(), b.tz[k] = h.tangential.z();
-    if constexpr (Law::rolling_history) b.rx[k] = h.rolling.x(), b.ry[k] = h.rolling.y(), b.rz[k] = h.rolling.z();
+    if constexpr (KeptHistories<Law>::tangential) b.tx[k] = h.tangential.x(), b.ty[k] = h.tangential.y(), b.tz[k] = h.tangential.z();
+    if constexpr (KeptHistories<Law>::rolling) b.rx[k] = h.rolling.x(), b.ry[k] = h.rolling.y(), b.rz[k] = h.rolling.z();
     b.overlap_rel[k] = c.overlap / std::min(ri, rj);
   }
 }
@@ -122,8 +132,8 @@ double apply_batch(const ContactBatch& b, State& s) {
       s.cross_forces.force[std::size_t(b.slot[k])] = -force;
       s.cross_forces.torque[std::size_t(b.slot[k])] = partner_torque;
     }
-    if constexpr (Law::tangential_history) nl.tangential[p] = Vec3(b.tx[k], b.ty[k], b.tz[k]);
-    if constexpr (Law::rolling_history) nl.rolling[p] = Vec3(b.rx[k], b.ry[k], b.rz[k]);
+    if constexpr (KeptHistories<Law>::tangential) nl.tangential[p] = Vec3(b.tx[k], b.ty[k], b.tz[k]);
+    if constexpr (KeptHistories<Law>::rolling) nl.rolling[p] = Vec3(b.rx[k], b.ry[k], b.rz[k]);
     max_overlap = std::max(max_overlap, b.overlap_rel[k]);
   }
   f[row] = row_force, torque[row] = row_torque;
@@ -256,8 +266,8 @@ void pair_forces(const Model& model, State& s) {
           for (std::uint32_t ended = swap_touching(touching + first, lanes, t.touching) & ~t.touching; ended; ended &= ended - 1) {
             const int k = std::countr_zero(ended);
             const auto p = std::size_t(first + k);
-            if constexpr (Law::tangential_history) nl.tangential[p].setZero();
-            if constexpr (Law::rolling_history) nl.rolling[p].setZero();
+            if constexpr (KeptHistories<Law>::tangential) nl.tangential[p].setZero();
+            if constexpr (KeptHistories<Law>::rolling) nl.rolling[p].setZero();
             if (const std::int32_t slot = slot_of(k); slot >= 0)
               s.cross_forces.force[std::size_t(slot)].setZero(), s.cross_forces.torque[std::size_t(slot)].setZero();
           }
@@ -273,11 +283,11 @@ void pair_forces(const Model& model, State& s) {
             b.ri[k] = ri, b.rj[k] = t.rj[lane], b.mi[k] = mi, b.mj[k] = mass[j];
             b.vix[k] = vi.x(), b.viy[k] = vi.y(), b.viz[k] = vi.z(), b.wix[k] = wi.x(), b.wiy[k] = wi.y(), b.wiz[k] = wi.z();
             b.vjx[k] = vj.x(), b.vjy[k] = vj.y(), b.vjz[k] = vj.z(), b.wjx[k] = wj.x(), b.wjy[k] = wj.y(), b.wjz[k] = wj.z();
-            if constexpr (Law::tangential_history) {
+            if constexpr (KeptHistories<Law>::tangential) {
               const Vec3& h = nl.tangential[std::size_t(p)];
               b.tx[k] = h.x(), b.ty[k] = h.y(), b.tz[k] = h.z();
             }
-            if constexpr (Law::rolling_history) {
+            if constexpr (KeptHistories<Law>::rolling) {
               const Vec3& h = nl.rolling[std::size_t(p)];
               b.rx[k] = h.x(), b.ry[k] = h.y(), b.rz[k] = h.z();
             }
