@@ -51,7 +51,7 @@ struct alignas(64) ContactBatch {
 // for every grain (Common) the pairs' parameters are that pair's, not gathered: a compile-time
 // choice, since a run-time one left the loop blending each parameter between a gathered column
 // and a copy on the stack, and the stack loads ran at a third of the speed in two processes of
-// three (the stack's placement decided; bench/results/liggghts_50k.json, README "Speed").
+// three (the stack's placement decided; docs/PERFORMANCE.md, "How the kernel is built").
 template <class Law, bool Common>
 [[gnu::flatten]] void evaluate(ContactBatch& b, double dt, const PairParams& common) {
   for (int k = 0; k < b.size; ++k) {
