@@ -222,9 +222,11 @@ std::pair<dem::Model, dem::State> ring_pack(std::size_t count, const fs::path& c
 }
 
 // The scaling case: dense settled beds of `count` grains cut from the settled LIGGGHTS pack (the
-// grains wholly inside a square column of it, so that none overlaps the column's walls, one column per tile, tiles side by side a grain apart in a
-// box of planes), so that every size is the same powder in the same state, and no hour-long pour
-// is needed for half a million grains. Tiles hold the column's grains lowest first.
+// grains wholly inside a square column of it, so that none overlaps the column's walls; one column
+// per tile, tiles side by side a grain apart in a box of planes), so that every size is the same
+// powder, and no hour-long pour is needed for half a million grains. Tiles hold the column's grains
+// lowest first. A bed smaller than one tile is a narrower square of the column, and looser than the
+// rest (docs/PERFORMANCE.md, "Against the grain count").
 std::pair<dem::Model, dem::State> tiled_pack(const dem::State& source, std::size_t count) {
   constexpr double column = 30e-3;  // the largest square the 44 mm cylinder holds, nearly
   std::vector<std::size_t> in_column;

@@ -31,7 +31,7 @@ fs::path suite_out() { return test::suite_folder("mpi"); }
 
 // No FEM hand-off: nothing here reads it, and rank 0 would mesh while the other spins. Grains of
 // 2.26 mm (α = 22.6): what is tested is that a split run is another realisation of the one-process
-// fill, which holds at any grain size (at 1.6 mm the ring runs took 4 times as long).
+// fill, which holds at any grain size (with 1.6 mm grains this test took 131 s on two cores, now 78).
 const std::string ring = fmt::format("{}/dies/ring.stl --set powder.coarse_graining=22.6 --set fem.elements=none", DIEFILL_SOURCE_DIR);
 
 // The ring at α = 22.6, 0.1 m/s, run by one process on seeds 1 to 15 (measured 2026-12-06:
