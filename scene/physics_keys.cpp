@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <set>
 
 namespace app {
 
@@ -22,7 +23,7 @@ const KeyTable<dem::Material>& material_keys() {
   using M = dem::Material;
   static const KeyTable<M> keys = {
       {"materials", "name", KeyType::text, "", {}, {}, Shapes::settling,
-       "what [[interactions]] and the scene call it; the pipeline needs \"powder\" and \"steel\"",
+       "what [[interactions]] and the scene call it; an entry named like a default (\"powder\", \"steel\") changes only the keys it gives",
        [](const M& m) -> KeyValue { return m.name; }, [](M& m, const KeyValue& v) { m.name = std::get<std::string>(v); }},
       field<M>("materials", "density", KeyType::number, "kg/m³", {100, 25000}, "of the solid grain material", &M::density),
       field<M>("materials", "youngs_modulus", KeyType::number, "Pa", {1e4, 1.2e12},
@@ -54,18 +55,20 @@ const KeyTable<InteractionEntry>& interaction_keys() {
 }
 
 std::vector<std::string> read_materials(Table& root, dem::ModelSpec& spec, const std::filesystem::path& base) {
-  std::vector<std::string> names;
-  std::vector<Table> materials = root.tables("materials");
-  if (!materials.empty()) spec.materials.clear();
-  for (Table& t : materials) {
-    dem::Material m;
-    m.name = fmt::format("material{}", names.size());
-    read_entry(t, "materials", material_keys(), m, base);
-    names.push_back(m.name);
-    spec.materials.push_back(m);
+  // An entry naming a material the spec already has changes only the keys it gives (a scene
+  // states what differs from the defaults); any other name adds a material.
+  std::set<std::string> named;
+  for (Table& t : root.tables("materials")) {
+    const std::string name = t.string("name").value_or(fmt::format("material{}", spec.materials.size()));
+    if (!named.insert(name).second)
+      t.fail("name", "names material '" + name + "' a second time", "Give each [[materials]] entry its own name, or merge the two");
+    const auto same_name = [&](const dem::Material& m) { return m.name == name; };
+    auto found = std::find_if(spec.materials.begin(), spec.materials.end(), same_name);
+    if (found == spec.materials.end()) found = spec.materials.insert(found, dem::Material{.name = name});
+    read_entry(t, "materials", material_keys(), *found, base);
   }
-  if (materials.empty())
-    for (const dem::Material& m : spec.materials) names.push_back(m.name);
+  std::vector<std::string> names;
+  for (const dem::Material& m : spec.materials) names.push_back(m.name);
   for (Table& t : root.tables("interactions")) {
     const auto pair = t.strings("materials");
     if (!pair || pair->size() != 2) t.fail("materials", "must name two materials", "Write materials = [\"a\", \"b\"]");

@@ -220,10 +220,6 @@ PipelineScene load_pipeline_scene(const std::optional<std::filesystem::path>& sc
   if (!(s.spec.gravity.z() < 0))
     refuse("simulation", "gravity", "must point down (negative z): the powder falls into the die",
            "Give gravity a negative z component, e.g. [0, 0, -9.81]");
-  for (const char* needed : {"powder", "steel"})
-    if (std::find(names.begin(), names.end(), needed) == names.end())
-      root.fail("materials", std::string("must define a material named \"") + needed + "\"",
-                "The powder is \"powder\"; the die and shoe are \"steel\"");
   // Powder slides on the polished die table more easily than on itself, unless told otherwise.
   if (s.spec.interactions.empty())
     s.spec.interactions.push_back({int(std::find(names.begin(), names.end(), "powder") - names.begin()),
@@ -247,7 +243,8 @@ std::string describe(const PipelineScene& s) {
 std::string scene_keys_markdown() {
   const PipelineScene defaults;
   return fmt::format(
-      "{}\nEach `[[materials]]` entry (defaults: \"powder\" and \"steel\", printed by `diefill scene`):\n\n{}\n"
+      "{}\nEach `[[materials]]` entry (defaults: \"powder\" and \"steel\", printed by `diefill scene`; an entry with one of "
+      "their names changes only the keys it gives, any other name adds a material):\n\n{}\n"
       "Each `[[interactions]]` entry names two materials (`materials = [\"a\", \"b\"]`) and replaces their mixing rule "
       "(geometric means) for the values it gives:\n\n{}",
       markdown_table(pipeline_keys(), defaults), markdown_table(material_keys(), defaults.spec.materials.front(), "materials[]."),

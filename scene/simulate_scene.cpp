@@ -203,8 +203,9 @@ SimulationScene load_simulation_scene(const fs::path& path, const std::vector<st
   SimulationScene scene;
   scene.source = path.string();
   const fs::path base = path.parent_path();
-  scene.spec.materials = {dem::Material{}};
-  scene.spec.materials[0].name = "default";
+  // One material when the scene names none; a scene's own materials start from nothing.
+  scene.spec.materials.clear();
+  if (!root.has("materials")) scene.spec.materials.push_back(dem::Material{.name = "default"});
   read_keys(root, simulation_keys(), scene, base);
   read_keys(root, output_keys(), scene.output, base);
   const std::vector<std::string> names = read_materials(root, scene.spec, base);

@@ -19,15 +19,17 @@
 
 namespace {
 
-// Loads the default scene with one override; returns the InputError's text, or "" when it loads.
-std::string refusal(const std::string& override_text) {
+// Loads a scene (default: the defaults) with its overrides; returns the InputError's text, or ""
+// when it loads.
+std::string refusal_of(const std::optional<std::filesystem::path>& scene, const std::vector<std::string>& overrides) {
   try {
-    app::load_pipeline_scene(std::nullopt, {override_text});
+    app::load_pipeline_scene(scene, overrides);
     return "";
   } catch (const diefill::InputError& e) {
     return e.what();
   }
 }
+std::string refusal(const std::string& override_text) { return refusal_of(std::nullopt, {override_text}); }
 
 // A value just outside a range, below or above (a whole number for an integer key); for a range
 // that allows 0 besides its interval, the gap between them and a negative value too.
@@ -92,6 +94,34 @@ TEST(SceneKeys, AbsurdValuesFoundByTheReviewAreRefusedByName) {
     EXPECT_EQ(run.status, 2) << line << ": " << run.output;
     EXPECT_NE(run.output.find(std::string(line).substr(0, std::string(line).find(' '))), std::string::npos) << run.output;
   }
+}
+
+// A scene states what differs: an entry named like a default material changes only the keys it
+// gives (issue 48); the other material and the other keys keep their defaults.
+TEST(SceneMaterials, AnEntryNamedLikeADefaultChangesOnlyItsKeys) {
+  test::TempDir dir;
+  test::write_text(dir / "scene.toml", "[[materials]]\nname = \"powder\"\nrolling_friction = 0.2\n");
+  const app::PipelineScene defaults;
+  const app::PipelineScene s = app::load_pipeline_scene(dir / "scene.toml", {});
+  ASSERT_EQ(s.spec.materials.size(), defaults.spec.materials.size());
+  const dem::Material& powder = s.spec.materials[std::size_t(app::material_named(s.spec, "powder"))];
+  const dem::Material& default_powder = defaults.spec.materials[std::size_t(app::material_named(defaults.spec, "powder"))];
+  EXPECT_EQ(powder.rolling_friction, 0.2);
+  EXPECT_EQ(powder.sliding_friction, default_powder.sliding_friction);
+  EXPECT_EQ(powder.density, default_powder.density);
+  EXPECT_EQ(s.spec.materials[std::size_t(app::material_named(s.spec, "steel"))].youngs_modulus,
+            defaults.spec.materials[std::size_t(app::material_named(defaults.spec, "steel"))].youngs_modulus);
+
+  const test::Run shown = test::run_diefill("scene " + (dir / "scene.toml").string());
+  ASSERT_EQ(shown.status, 0) << shown.output;
+  EXPECT_NE(shown.output.find("name = \"steel\""), std::string::npos) << shown.output;
+  EXPECT_NE(shown.output.find("rolling_friction = 0.2"), std::string::npos) << shown.output;
+
+  // A new name adds a material; the same name twice is refused, naming the entry.
+  test::write_text(dir / "scene.toml", "[[materials]]\nname = \"brass\"\ndensity = 8500\n");
+  EXPECT_EQ(app::load_pipeline_scene(dir / "scene.toml", {}).spec.materials.size(), defaults.spec.materials.size() + 1);
+  test::write_text(dir / "scene.toml", "[[materials]]\nname = \"powder\"\n\n[[materials]]\nname = \"powder\"\n");
+  EXPECT_NE(refusal_of(dir / "scene.toml", {}).find("materials[1].name"), std::string::npos);
 }
 
 namespace {
