@@ -19,6 +19,7 @@
 #include "pipeline/preflight.hpp"
 #include "pipeline/sweep.hpp"
 #include "pipeline/run_loop.hpp"
+#include "studies/measured_powder.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -179,6 +180,11 @@ int run_plan(const PlanCommand& c) {
 int run_scene(const SceneCommand& c) {
   if (c.keys) {
     fmt::print("{}", scene_keys_markdown());
+    return 0;
+  }
+  if (study::is_measured_powder(c.target) && c.overrides.empty()) {
+    fmt::print("# a measured powder for `diefill calibrate`, fully resolved ({})\n{}", c.target.string(),
+               study::measured_powder_toml(study::read_measured_powder(c.target)));
     return 0;
   }
   PipelineScene scene = scene_for(c.target, c.overrides);

@@ -5,6 +5,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/mpi_session.hpp"
+#include "studies/calibrate.hpp"
 #include "studies/studies.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -184,6 +185,18 @@ void add_study(CLI::App& root, app::study::StudyRequest& c, std::function<int()>
   cmd->callback([&] { action = [&] { return app::study::run_study(c); }; });
 }
 
+void add_calibrate(CLI::App& root, app::study::CalibrateRequest& c, std::function<int()>& action) {
+  CLI::App* cmd = root.add_subcommand("calibrate", "Fit sliding and rolling friction to a powder's lab measurements; a [[materials]] "
+                                                   "block with its confidence in OUT/calibrated.toml");
+  cmd->add_option("MEASURED", c.measured, "What the lab measured (.toml: docs/INTERFACE.md, \"The measured powder\")")->required();
+  cmd->add_option("-o,--out", c.out, "Output folder")->capture_default_str();
+  cmd->add_flag("--resume", c.resume, "Keep the tests an interrupted calibration finished");
+  cmd->add_option("--set", c.overrides, "Override a scene key of the simulated powder: --set contact.rolling=epsd");
+  cmd->add_option("--threads", c.threads, "Threads (default: all cores); results do not depend on it");
+  cmd->add_option("--seed", c.seed, "Random seed of the simulated tests")->capture_default_str();
+  cmd->callback([&] { action = [&] { return app::study::run_calibrate(c); }; });
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -226,6 +239,8 @@ int main(int argc, char** argv) {
   add_clump(root, clump, action);
   app::study::StudyRequest study;
   add_study(root, study, action);
+  app::study::CalibrateRequest calibrate;
+  add_calibrate(root, calibrate, action);
   try {
     root.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

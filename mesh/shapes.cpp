@@ -188,6 +188,26 @@ TriMesh box_solid(const Vec3& lo, const Vec3& hi) {
   return m;
 }
 
+TriMesh revolved_solid(const std::vector<std::array<double, 2>>& profile, int segments) {
+  TriMesh m;
+  const int n = int(profile.size());
+  for (const auto& [r, z] : profile)
+    for (int j = 0; j < segments; ++j) {
+      const double theta = 2 * std::numbers::pi * j / segments;
+      m.vertices.emplace_back(r * std::cos(theta), r * std::sin(theta), z);
+    }
+  // Each profile edge turned through one step is a quad; with the profile counter-clockwise in
+  // (r, z), (a, d, c) and (a, c, b) face outward.
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < segments; ++j) {
+      const int next_j = (j + 1) % segments, next_i = (i + 1) % n;
+      const int a = i * segments + j, b = next_i * segments + j, c = next_i * segments + next_j, d = i * segments + next_j;
+      m.triangles.push_back({a, d, c});
+      m.triangles.push_back({a, c, b});
+    }
+  return m;
+}
+
 TriMesh shoe_solid(double inner_length, double inner_width, double height, double thickness) {
   // A rectangular tube: outer and inner rectangles at z = 0 and z = height, joined.
   TriMesh m;

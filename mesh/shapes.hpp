@@ -16,6 +16,10 @@ TriMesh ring_cavity(double outer_diameter, double inner_diameter, double depth, 
 // Axis-aligned box [lo, hi], outward-oriented, two triangles a face.
 TriMesh box_solid(const Vec3& lo, const Vec3& hi);
 
+// A solid of revolution about the z axis: the closed profile polygon (r > 0, z), counter-clockwise
+// in the (r, z) plane, turned through `segments` steps. Outward-oriented, closed.
+TriMesh revolved_solid(const std::vector<std::array<double, 2>>& profile, int segments);
+
 // A feeding shoe: four walls of `thickness` around an inner rectangle (x along the motion,
 // y across), from z = 0 to `height`, open at the bottom and the top. Outward-oriented, closed;
 // the inner rectangle is centred on the origin.

@@ -43,17 +43,7 @@ void repose(const PipelineScene& scene, bool reduced, Output& out) {
   for (double mu_r : rolling) cases.push_back({grain.sliding_friction, mu_r});
   if (reduced) cases.push_back({grain.sliding_friction, grain.rolling_friction});
 
-  Heap heap;
-  heap.pedestal_radius = (reduced ? 10 : 15) * d;
-  // Grains enough for a 45° cone over the pedestal and the dish's layer at a solid fraction of
-  // 0.6, so that the heap reaches its angle and sheds over the edge before the pour ends (with
-  // just a 35° cone's worth it stayed a flat-topped mound); poured in about a second.
-  const auto grains_in = [&](double bulk_volume) { return 0.6 * bulk_volume / grain_volume(d); };
-  const double area = std::numbers::pi * heap.pedestal_radius * heap.pedestal_radius;
-  heap.grains = std::size_t(grains_in(area * heap.pedestal_radius / 3 + area * d));
-  heap.pour_rate = double(heap.grains);
-  heap.drop_height = 2 * d;
-  heap.stream_radius = 3 * d;
+  const Heap heap = funnel_heap(d, reduced ? 10 : 15);
   const SlotContainer drain = outflow_container(d, reduced);
 
   // Beds of other seeds per friction, pooled (study_kit.hpp): one reduced bed's angles move by

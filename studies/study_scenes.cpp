@@ -93,6 +93,11 @@ dem::ModelSpec slot_walls(const Powder& p, const SlotContainer& c) {
                             p.wall, "floor -x"),
                  block_wall(Vec3(0.5 * c.slot_width, -half_w - past, -floor), Vec3(half_l + past, half_w + past, 0), r,
                             p.wall, "floor +x")};
+  if (c.slot_length > 0 && c.slot_length < c.width) {
+    const double half_slot = 0.5 * c.slot_width, half_length = 0.5 * c.slot_length;
+    spec.meshes.push_back(block_wall(Vec3(-half_slot, -half_w - past, -floor), Vec3(half_slot, -half_length, 0), r, p.wall, "floor -y"));
+    spec.meshes.push_back(block_wall(Vec3(-half_slot, half_length, -floor), Vec3(half_slot, half_w + past, 0), r, p.wall, "floor +y"));
+  }
   spec.domain = {Vec3(-half_l - past, -half_w - past, -floor - 4 * d), Vec3(half_l + past, half_w + past, pour_height(c) + 10 * d)};
   spec.max_impact_speed = std::max(spec.max_impact_speed, std::sqrt(2 * spec.gravity.norm() * pour_height(c)));
   return spec;
@@ -128,16 +133,16 @@ SlotBed settle_slot_bed(const Powder& p, const SlotContainer& c, const std::stri
   return bed;
 }
 
-SlotRun drain_slot_bed(const Powder& p, const SlotContainer& c, SlotBed bed, const std::string& label) {
-  const double floor = 2 * p.r_max();
+SlotRun drain_bed(const Powder& p, const dem::ModelSpec& open_walls, const SlotContainer& c, SlotBed bed, double gone_below,
+                  const std::string& label) {
   SlotRun run;
   static_cast<SlotBed&>(run) = std::move(bed);
   // Open the gate.
   forget_wall_contacts(run.state);
-  const dem::Model open = dem::compile_model(slot_walls(p, c), run.state, p.source);
+  const dem::Model open = dem::compile_model(open_walls, run.state, p.source);
   dem::initialize(open, run.state);
   const double opened = run.state.time;
-  const auto gone = [&](std::size_t i) { return !run.state.active[i] || run.state.x[i].z() < -floor; };
+  const auto gone = [&](std::size_t i) { return !run.state.active[i] || run.state.x[i].z() < gone_below; };
   double quiet_since = opened;
   LoopOptions sampling;
   sampling.outputs.push_back({c.sample_every, [&](const dem::State& s) {
@@ -154,6 +159,10 @@ SlotRun drain_slot_bed(const Powder& p, const SlotContainer& c, SlotBed bed, con
   return run;
 }
 
+SlotRun drain_slot_bed(const Powder& p, const SlotContainer& c, SlotBed bed, const std::string& label) {
+  return drain_bed(p, slot_walls(p, c), c, std::move(bed), -2 * p.r_max(), label);
+}
+
 SlotRun run_slot_container(const Powder& p, const SlotContainer& c, const std::string& label) {
   return drain_slot_bed(p, c, settle_slot_bed(p, c, label), label);
 }
@@ -168,6 +177,20 @@ LineFit steady_rate(const SlotRun& run) {
     if (run.time[i] >= steady_flow_transient && run.discharged[i] <= steady_flow_until_lost * run.initial_mass)
       t.push_back(run.time[i]), m.push_back(run.discharged[i]);
   return fit_line(t, m);
+}
+
+Heap funnel_heap(double d, double pedestal_grains) {
+  Heap heap;
+  heap.pedestal_radius = pedestal_grains * d;
+  // Grains enough for a 45° cone over the pedestal and the dish's layer at a solid fraction of
+  // 0.6, so that the heap reaches its angle and sheds over the edge before the pour ends (with
+  // just a 35° cone's worth it stayed a flat-topped mound); poured in about a second.
+  const double area = std::numbers::pi * heap.pedestal_radius * heap.pedestal_radius;
+  heap.grains = std::size_t(0.6 * (area * heap.pedestal_radius / 3 + area * d) / grain_volume(d));
+  heap.pour_rate = double(heap.grains);
+  heap.drop_height = 2 * d;
+  heap.stream_radius = 3 * d;
+  return heap;
 }
 
 HeapRun run_heap(const Powder& p, const Heap& h, const std::string& label) {

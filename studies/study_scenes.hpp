@@ -18,6 +18,7 @@ double grain_volume(double diameter);  // [m³] of a sphere
 struct SlotContainer {
   double length = 0, width = 0, fill_height = 0;  // inner [m]; the slot runs along y, across the width
   double slot_width = 0;                          // [m], centred at x = 0
+  double slot_length = 0;                         // [m] along y, centred; 0: the whole width (a square slot: an orifice)
   double settle_time = 0.15;                      // [s] with the gate shut
   double flow_time = 0.3;                         // [s] after opening, at most
   double sample_every = 2.5e-3;                   // [s]
@@ -46,6 +47,10 @@ SlotRun run_slot_container(const Powder& powder, const SlotContainer& container,
 // a bed settled in `container` drains through any slot of a container of its size.
 SlotBed settle_slot_bed(const Powder& powder, const SlotContainer& container, const std::string& label);
 SlotRun drain_slot_bed(const Powder& powder, const SlotContainer& container, SlotBed bed, const std::string& label);
+// A settled bed drained through the walls of `open_walls` (its gate gone), a grain counted out
+// once below `gone_below` [m]; `timing` gives the sampling, the longest flow and when to stop.
+SlotRun drain_bed(const Powder& powder, const dem::ModelSpec& open_walls, const SlotContainer& timing, SlotBed bed, double gone_below,
+                  const std::string& label);
 // The Beverloo slot law's geometry (L - k d)(b - k d)^{3/2} [m^{5/2}]: the rate over C_s rho_b sqrt(g).
 double beverloo_slot(double length, double width, double k, double d);
 // The steady discharge rate [kg/s]: a line through the discharged mass after the opening's
@@ -68,6 +73,9 @@ struct HeapRun {
 };
 
 HeapRun run_heap(const Powder& powder, const Heap& heap, const std::string& label);
+// The heap of the fixed-base funnel test on a pedestal `pedestal_grains` grains of `diameter` in
+// radius, poured in about a second.
+Heap funnel_heap(double diameter, double pedestal_grains);
 
 // A free surface: the highest grain top per column, fitted with a straight line between `from`
 // and `to` along the column coordinate.

@@ -1,0 +1,53 @@
+#pragma once
+// The fit of `diefill calibrate` (calibrate.hpp): each simulated result mapped over the two
+// frictions, the frictions that meet the measurements, their confidence, and the outputs.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "studies/calibrate.hpp"
+
+namespace app::study {
+
+struct DesignPoint {
+  double sliding = 0, rolling = 0;
+  std::uint64_t seed = 1;
+};
+struct Finished {
+  DesignPoint point;
+  TestResults results;
+};
+
+// One measured quantity against its map y = b0 + b1 μ + b2 μ_r + b3 μ μ_r over the design.
+struct ObservableFit {
+  std::string name, unit;
+  double measured = 0, measured_error = 0;  // the lab's value and its standard error
+  bool used = true;
+  std::string left_out;                     // why, when not used
+  double coefficients[4] = {0, 0, 0, 0};
+  double scatter = 0;                       // of the tests about the map (the seed's noise)
+  double fitted = 0;                        // the map at the calibrated frictions
+  double residual = 0;                      // (fitted − measured) in combined standard errors
+};
+
+struct CalibrationFit {
+  double sliding = 0, rolling = 0;
+  double sliding_ci = 0, rolling_ci = 0;            // 95 % half-widths
+  double sliding_data_ci = 0, rolling_data_ci = 0;  // the measurements' alone (infinite: they do not fix it)
+  bool sliding_pinned = false, rolling_pinned = false;
+  bool inside_design = true;
+  std::vector<ObservableFit> observables;
+};
+
+// A parameter counts as pinned when the measurements alone fix it to this (95 %).
+inline constexpr double pinned_within = 0.05;
+
+CalibrationFit fit_frictions(const std::vector<Finished>& tests, const MeasuredPowder& measured, const SimulatedTests& simulated);
+
+// OUT/calibrated.toml (the [powder] keys and the [[materials]] entry, the confidence as
+// comments), OUT/calibration.json and OUT/calibration_tests.csv; each written whole or not at all.
+void write_calibration(const std::filesystem::path& out, const MeasuredPowder& measured, const SimulatedTests& simulated,
+                       const std::vector<Finished>& tests, const CalibrationFit& fit);
+
+}  // namespace app::study
