@@ -28,6 +28,7 @@ namespace app::study {
 namespace fs = std::filesystem;
 
 double beverloo_orifice(double orifice, double d) {
+  // The lab's gravity, and the simulated tests' (the scene's default).
   return std::sqrt(9.81) * std::pow(std::max(0.0, orifice - beverloo_k * d), 2.5);
 }
 
@@ -112,10 +113,7 @@ SlotBed settle_funnel_bed(const Powder& p, const Funnel& f, const std::string& l
   const dem::Model shut = dem::compile_model(gated, bed.state, p.source);
   dem::initialize(shut, bed.state);
   advance(shut, bed.state, 0.2, label + ": settling");
-  std::vector<double> z;
-  for (std::size_t i = 0; i < bed.state.size(); ++i) z.push_back(bed.state.x[i].z());
-  std::nth_element(z.begin(), z.begin() + std::ptrdiff_t(0.97 * double(z.size() - 1)), z.end());
-  bed.bed_height = z[std::size_t(0.97 * double(z.size() - 1))];
+  bed.bed_height = centre_height_quantile(bed.state, 0.97);
   double solid = 0, core_volume = 0;
   const double lo = 2 * d, hi = bed.bed_height - 2 * d, slice = 0.05 * d;
   for (double s = lo; s < hi; s += slice) core_volume += std::numbers::pi * std::pow(std::max(0.0, f.inner_radius(s) - 2 * d), 2) * slice;
@@ -171,8 +169,8 @@ std::vector<DesignPoint> design(std::uint64_t seed) {
 std::string test_key(const MeasuredPowder& m, const CalibrateRequest& c, const DesignPoint& p) {
   std::string keys;
   for (const std::string& o : c.overrides) keys += o + ";";
-  return diefill::sha256_hex(fmt::format("{} {} {} {} {} {} {} {}", m.particle_diameter, m.diameter_spread, m.material_density,
-                                         m.orifice_diameter, keys, p.sliding, p.rolling, p.seed) +
+  return diefill::sha256_hex(fmt::format("{} {} {} {} {} {} {} {} {}", m.particle_diameter, m.diameter_spread, m.material_density,
+                                         m.orifice_diameter, m.funnel_half_angle_deg, keys, p.sliding, p.rolling, p.seed) +
                              std::string(dem::source_hash()));
 }
 
@@ -259,7 +257,7 @@ int run_calibrate(const CalibrateRequest& c) {
                c.measured.string(), c.out.string());
     return diefill::exit_interrupted;
   }
-  const CalibrationFit fit = fit_frictions(results, measured, tests);
+  const CalibrationFit fit = fit_frictions(results, measured);
   write_calibration(c.out, measured, tests, results, fit);
   diefill::log::info("calibrate: {:.0f} s -> {}", clock.seconds(), (c.out / "calibrated.toml").string());
   return 0;

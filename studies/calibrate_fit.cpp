@@ -108,7 +108,7 @@ Vector2 best_frictions(const std::vector<ObservableFit>& obs) {
 
 }  // namespace
 
-CalibrationFit fit_frictions(const std::vector<Finished>& tests, const MeasuredPowder& measured, const SimulatedTests&) {
+CalibrationFit fit_frictions(const std::vector<Finished>& tests, const MeasuredPowder& measured) {
   CalibrationFit fit;
   fit.observables = observables(tests, measured);
   const Vector2 p = best_frictions(fit.observables);
@@ -127,11 +127,12 @@ CalibrationFit fit_frictions(const std::vector<Finished>& tests, const MeasuredP
   fit.rolling_data_ci = data_ci[1];
   fit.sliding_pinned = data_ci[0] <= pinned_within;
   fit.rolling_pinned = data_ci[1] <= pinned_within;
-  double lo_mu = 1e9, hi_mu = -1e9, lo_r = 1e9, hi_r = -1e9;
-  for (const Finished& t : tests)
-    lo_mu = std::min(lo_mu, t.point.sliding), hi_mu = std::max(hi_mu, t.point.sliding), lo_r = std::min(lo_r, t.point.rolling),
-    hi_r = std::max(hi_r, t.point.rolling);
-  fit.inside_design = p[0] >= lo_mu && p[0] <= hi_mu && p[1] >= lo_r && p[1] <= hi_r;
+  const auto within = [&](double x, double DesignPoint::*along) {
+    const auto [lo, hi] = std::minmax_element(tests.begin(), tests.end(),
+                                              [&](const Finished& a, const Finished& b) { return a.point.*along < b.point.*along; });
+    return x >= lo->point.*along && x <= hi->point.*along;
+  };
+  fit.inside_design = within(p[0], &DesignPoint::sliding) && within(p[1], &DesignPoint::rolling);
   for (ObservableFit& o : fit.observables) {
     o.fitted = map_at(o, p);
     o.residual = (o.fitted - o.measured) * std::sqrt(weight(o));

@@ -43,7 +43,7 @@ struct CalibrationFit {
 // A parameter counts as pinned when the measurements alone fix it to this (95 %).
 inline constexpr double pinned_within = 0.05;
 
-CalibrationFit fit_frictions(const std::vector<Finished>& tests, const MeasuredPowder& measured, const SimulatedTests& simulated);
+CalibrationFit fit_frictions(const std::vector<Finished>& tests, const MeasuredPowder& measured);
 
 // OUT/calibrated.toml (the [powder] keys and the [[materials]] entry, the confidence as
 // comments), OUT/calibration.json and OUT/calibration_tests.csv; each written whole or not at all.

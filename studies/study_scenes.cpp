@@ -18,16 +18,6 @@ using dem::Vec3;
 
 double grain_volume(double diameter) { return std::numbers::pi / 6 * diameter * diameter * diameter; }
 
-namespace {
-
-// Poured loose, the powder settles to a solid fraction of about 0.6 from 0.42.
-double pour_height(const SlotContainer& c) { return c.fill_height * 0.6 / 0.42; }
-
-dem::PlaneWall plane(const Vec3& point, const Vec3& normal, int material, const std::string& name) {
-  return {point, normal, material, name};
-}
-
-// Height below which a fraction `q` of the grains' centres lie.
 double centre_height_quantile(const dem::State& s, double q) {
   std::vector<double> z;
   for (std::size_t i = 0; i < s.size(); ++i)
@@ -37,6 +27,16 @@ double centre_height_quantile(const dem::State& s, double q) {
   std::nth_element(z.begin(), z.begin() + std::ptrdiff_t(k), z.end());
   return z[k];
 }
+
+namespace {
+
+// Poured loose, the powder settles to a solid fraction of about 0.6 from 0.42.
+double pour_height(const SlotContainer& c) { return c.fill_height * 0.6 / 0.42; }
+
+dem::PlaneWall plane(const Vec3& point, const Vec3& normal, int material, const std::string& name) {
+  return {point, normal, material, name};
+}
+
 
 // Highest grain top per column (column index from `coordinate`), for the columns in [0, count).
 template <class Column>

@@ -14,6 +14,8 @@
 namespace app::study {
 
 double grain_volume(double diameter);  // [m³] of a sphere
+// Height below which a fraction `q` of the active grains' centres lie [m].
+double centre_height_quantile(const dem::State& state, double q);
 
 struct SlotContainer {
   double length = 0, width = 0, fill_height = 0;  // inner [m]; the slot runs along y, across the width

@@ -8,6 +8,7 @@
 #include "mesh/die.hpp"
 #include "mesh/import.hpp"
 #include "mesh/orientation.hpp"
+#include "mesh/repair.hpp"
 #include "mesh/shapes.hpp"
 #include "meshes.hpp"
 #include "support.hpp"
@@ -56,6 +57,16 @@ TEST(BundledDies, MeetChordToleranceAndAnalyticVolume) {
     EXPECT_DOUBLE_EQ(box.hi.z(), 0.0) << name << ": top face on the die table";
     EXPECT_DOUBLE_EQ(box.lo.z(), -10e-3) << name;
   }
+}
+
+// A rectangle (r from 3 to 5 mm, z from 0 to 4 mm) turned about the axis is the polygonal annulus
+// of that many sides, closed and oriented outward: its divergence-theorem volume is the annulus's
+// (negative, or short of it, if a face were flipped or missing).
+TEST(RevolvedSolid, IsTheClosedPolygonalAnnulus) {
+  const int n = 32;
+  const mesh::TriMesh tube = mesh::revolved_solid({{3e-3, 0}, {5e-3, 0}, {5e-3, 4e-3}, {3e-3, 4e-3}}, n);
+  EXPECT_NEAR(mesh::signed_volume(tube), polygon_annulus_volume(5e-3, 3e-3, 4e-3, n), 1e-15);
+  EXPECT_TRUE(mesh::inspect(tube).closed);
 }
 
 TEST(BundledDies, FilesInDiesAreTheGeneratedOnes) {
