@@ -127,7 +127,7 @@ void cut_at_parting_plane(PreparedDie& die, const std::string& source) {
 
 // The `part`-th largest of an assembly's bodies by enclosed volume (1: the largest; ties in the
 // file's order). A die forms one part; an assembly's parts stand apart by clearances no die wall
-// is as thin as (README, "Assemblies").
+// is as thin as (docs/MESHES.md, "Assemblies").
 TriMesh body_of_assembly(std::vector<TriMesh> bodies, int part, const std::string& source) {
   std::vector<double> volume(bodies.size());
   std::transform(bodies.begin(), bodies.end(), volume.begin(), [](const TriMesh& b) { return std::abs(signed_volume(b)); });

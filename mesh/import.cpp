@@ -140,7 +140,7 @@ ImportResult import_mesh(const fs::path& path, const ImportOptions& options) {
   if (result.unit_guessed && result.unit != LengthUnit::mm) {
     std::string msg = fmt::format(
         "{}: no unit given; the mesh is {:.4g} across in the file's numbers, read as {} ({:.4g} mm across: "
-        "README, \"Units\"). Declare the unit (--units, or die.units in the scene) if that is wrong",
+        "docs/MESHES.md, \"Units\"). Declare the unit (--units, or die.units in the scene) if that is wrong",
         path.string(), extent_in_file, unit_name(result.unit), extent_in_file * scale * 1e3);
     diefill::log::write_warning(msg);
     result.warnings.push_back(msg);

@@ -15,7 +15,7 @@ namespace {
 constexpr int shadow_cells = 256;
 // A flat top face that leaves more than half of the part's outline closed is no opening (a tooth
 // tip, a boss's end face: the shared 8-tooth gear and flanged ring, 3 % and 9 % of theirs); the
-// slot die's 1.2 mm opening is the whole of its outline. The project's choice, README "Dies".
+// slot die's 1.2 mm opening is the whole of its outline. The project's choice, docs/MESHES.md "Dies".
 constexpr double min_top_open_share = 0.5;
 // Levels the widest section is sought among: a section to 1/256 of the part's height.
 constexpr int section_levels = 256;

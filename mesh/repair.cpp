@@ -150,7 +150,7 @@ std::optional<SmallFoldsWelded> weld_small_folds(const TriMesh& mesh, double tol
 
 // The winding-number route is refused beyond this much ambiguous volume, as a share of the
 // solid: a crack or a small hole leaves a sliver of it, a missing face a region as large as the
-// part (README, "Mesh repair"). The project's choice, not a published bound.
+// part (docs/MESHES.md, "Mesh repair"). The project's choice, not a published bound.
 constexpr double max_ambiguous_share = 0.01;
 // Survey cells the solid must fill for its ambiguous share to mean anything: a corrupt vertex
 // hundreds of metres away stretches the survey's box until the part sits in a cell or two

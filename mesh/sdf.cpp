@@ -267,7 +267,7 @@ SdfGrid build_sdf(const TriMesh& solid, const SdfOptions& options) {
   // Our solids cross nowhere (repair's contract), so OpenVDB's removal of "self-intersecting"
   // voxels has nothing to remove and only errs: beside free space thinner than a voxel it
   // deactivated band voxels 0.03 voxel from the wall, and the flood fill then signed them from
-  // across the wall (the toothed pulley: 1,007 of 10^5 points against its own solid; README,
+  // across the wall (the toothed pulley: 1,007 of 10^5 points against its own solid; docs/MESHES.md,
   // "Shared test meshes").
   const int flags = openvdb::tools::DISABLE_RENORMALIZATION | openvdb::tools::DISABLE_INTERSECTING_VOXEL_REMOVAL;
   SdfGrid out;

@@ -111,7 +111,7 @@ std::optional<TriMesh> with_short_edges_collapsed(const TriMesh& body, double le
 // features makes Mesh_3 protect them with balls that small and refine all around them (the
 // planetary gear set's ring gear has edges of 2 µm: alone, its mesh had not ended after 2
 // minutes, a planet's took under 30 s), and leaves elements CalculiX refuses (the turbine
-// blade's edges of 0.2-0.5 µm, README, "Shared dies through the pipeline"). First the vertices
+// blade's edges of 0.2-0.5 µm, docs/MESHES.md, "Shared dies through the pipeline"). First the vertices
 // that close welded, which also closes a seam folding through itself in slivers that thin, where
 // that leaves a clean body (on the blade it crosses the surface); then, on that or the body as
 // it is, the short edges collapsed and the flat caps flipped along the surface (the flanged
@@ -171,7 +171,7 @@ TetMesh tetrahedralise_body(const TriMesh& body, const TetMeshOptions& o) {
 // Each separate body alone, their meshes joined: Mesh_3 keeps the protecting balls of sharp
 // edges apart, so edges of two bodies 0.11 mm apart (the teeth of the planetary gear set's
 // gears, where they mesh) shrank the balls and the elements around them to that gap, and the
-// gear set's mesh had not ended after 8 minutes (README, "Shared dies through the pipeline").
+// gear set's mesh had not ended after 8 minutes (docs/MESHES.md, "Shared dies through the pipeline").
 TetMesh tetrahedralise_here(const TriMesh& surface, const TetMeshOptions& o) {
   const std::vector<TriMesh> bodies = separate_bodies(surface);
   if (bodies.size() == 1) return tetrahedralise_body(surface, o);  // as given, vertex order and all

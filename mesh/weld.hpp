@@ -1,7 +1,7 @@
 #pragma once
 // Vertex welding: a fold of a surface smaller than a weld distance (a CAD seam whose two ends
 // miss each other by microns, so that its slivers fold over one another) closes when the
-// vertices closer than that distance become one (README, "Mesh repair").
+// vertices closer than that distance become one (docs/MESHES.md, "Mesh repair").
 #include <cstddef>
 
 #include "mesh/trimesh.hpp"

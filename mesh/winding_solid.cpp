@@ -269,7 +269,7 @@ WindingSolid on_input(TriMesh zero, const TriMesh& soup, const ExactSurface& sur
   // faces of parts in contact, across a sliver of outside (`in_contact_sliver`), nor those the
   // result covers where no grain of the closable diameter can touch them from the free space
   // (`gaps`): there the cells are too coarse to keep the free space open, and no grain could
-  // tell (README, "Mesh repair").
+  // tell (docs/MESHES.md, "Mesh repair").
   const double offset = 0.25 * cell_m;
   const GrainProbe grain{winding, surface, 0.5 * gaps.closable_m};
   // The samples are asked on every core (farthest_sample): the result's exact surface is built

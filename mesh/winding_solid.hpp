@@ -1,7 +1,7 @@
 #pragma once
 // Internal to the mesh module: the solid a messy surface means, as the region where its
 // generalized winding number (mesh/winding.hpp) is at least ½, re-meshed as a closed surface.
-// Repair's route for open, non-manifold and self-intersecting files (README, "Mesh
+// Repair's route for open, non-manifold and self-intersecting files (docs/MESHES.md, "Mesh
 // repair"): the existing surface is kept where it bounds that region, within the cell size.
 #include "mesh/trimesh.hpp"
 
@@ -26,7 +26,7 @@ WindingSurvey survey_winding(const TriMesh& soup, int cells = 96);
 // the solid that a segment this long spans from solid to solid (crossed squarely through its
 // middle: up to half of it from a face; on cells under 0.4 mm, shorter, as in_contact_sliver
 // says) is such a contact, which the model means as solid
-// throughout, not a gap (README, "Mesh repair"); a die wall 0.15 mm thick is no contact.
+// throughout, not a gap (docs/MESHES.md, "Mesh repair"); a die wall 0.15 mm thick is no contact.
 constexpr double contact_gap_m = 0.1e-3;
 
 struct WindingSolid {

@@ -41,7 +41,7 @@ DieSource read_die(const PipelineScene& scene, const std::filesystem::path& die_
                        die.file.name, mesh::up_name(die.file.up));
   if (die.file.part == 0 && die.file.bodies > 1)
     diefill::log::info("{}: the file holds {} separate bodies (pieces that share no vertex), filled as one part; if they are "
-                       "an assembly's parts, die.part = N takes the N-th largest alone (README, \"Assemblies\")",
+                       "an assembly's parts, die.part = N takes the N-th largest alone (docs/MESHES.md, \"Assemblies\")",
                        die.file.name, die.file.bodies);
   die.box = mesh::bounding_box(die.file.mesh);
   if (die.file.parting_z) {

@@ -27,7 +27,7 @@ struct CalibrateRequest {
 // Returns the exit status (130 when interrupted: the finished tests stay for --resume).
 int run_calibrate(const CalibrateRequest& request);
 
-// Beverloo's k for these spheres: the coarse-graining study's (README, "Studies": 1.81 made the
+// Beverloo's k for these spheres: the coarse-graining study's (docs/STUDIES.md: 1.81 made the
 // flow rates of three grain sizes one law).
 inline constexpr double beverloo_k = 1.8;
 // Beverloo's law through a round orifice, Ẇ = C ρ_b √g (D − k d)^{5/2}: the factor after C ρ_b.

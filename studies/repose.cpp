@@ -35,7 +35,7 @@ void repose(const PipelineScene& scene, bool reduced, Output& out) {
   const dem::Material& grain = base.spec.materials[std::size_t(base.powder)];
   // Sliding friction swept at the scene's rolling friction, and rolling at its sliding. Reduced,
   // one step each way, wide enough to show above the small beds' scatter (from 0.25 the outflow
-  // angle rose 1.5° with errors of 2°: README, "Studies").
+  // angle rose 1.5° with errors of 2°: docs/STUDIES.md).
   const std::vector<double> sliding = reduced ? std::vector<double>{0.1} : std::vector<double>{0.2, 0.35, 0.5, 0.7, 0.9};
   const std::vector<double> rolling = reduced ? std::vector<double>{0.0} : std::vector<double>{0.0, 0.05, 0.2, 0.4};
   std::vector<Friction> cases;

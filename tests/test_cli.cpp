@@ -74,7 +74,7 @@ TEST(Cli, SdfRejectsBadMeshesClearly) {
   expect_bad_input("sdf --role tool " + d + "/nested.stl", "nested.stl", "inside another shell");
   mesh::write_stl(ring, dir / "ring_in_metres.stl", mesh::LengthUnit::m, "ring, m");
   // Declared millimetres, a ring stored in metres is too small for the voxel (undeclared, its
-  // size says metres: README, "Units").
+  // size says metres: docs/MESHES.md, "Units").
   expect_bad_input("sdf --units mm " + d + "/ring_in_metres.stl", "ring_in_metres.stl", "--units m");
   const test::Run guessed = test::run_diefill("sdf --voxel 0.5 " + d + "/ring_in_metres.stl");
   EXPECT_EQ(guessed.status, 0) << guessed.output;

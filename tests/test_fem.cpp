@@ -179,7 +179,7 @@ TEST(TetMesh, EdgesShorterThanTheFacetDistanceShrinkNoElement) {
   EXPECT_NEAR(mesh_volume(m), a * a * a, 1e-3 * a * a * a);
 }
 
-// Shared dies meshed as their pipeline runs mesh them (README, "Shared dies through the
+// Shared dies meshed as their pipeline runs mesh them (docs/MESHES.md, "Shared dies through the
 // pipeline"): the largest grain radius, the SDF voxel and the element size of that run.
 struct SharedCavity {
   const char* file;
@@ -314,9 +314,9 @@ struct WallLayerLattice {
 // 44): elements at the side walls and at the floor read their layers' truth to 1 % on average,
 // while that truth lies 7 % and 15 % below the interior's. Per element the hand-off adds at most
 // 0.016 RMS to the sampling's own scatter: half of what one run's packing scatters per voxel (5.8 %
-// of 0.55 between two seeds of the default ring, README), so that the hand-off's own error stays
-// below the noise it hands on. The elements hold the lattice's volume below the table
-// to the hand-off's promise (0.5 %), measured with no correction (there is none).
+// of 0.55 between two seeds of the default ring, docs/STUDIES.md, "speed-accuracy"), so that the
+// hand-off's own error stays below the noise it hands on. The elements hold the lattice's volume
+// below the table to the hand-off's promise (0.5 %), measured with no correction (there is none).
 TEST(FemFill, ElementsReadTheLatticeTheyHoldWallLayersIncluded) {
   const WallLayerLattice lattice;
   const double phi = std::numbers::pi / (3 * std::sqrt(2.0));

@@ -228,7 +228,7 @@ TEST(Orientation, ADieFileOnItsSideIsReadFacingUp) {
   EXPECT_LT((a.lo - b.lo).norm() + (a.hi - b.hi).norm(), 1e-8);
 }
 
-// An assembly's file (README, "Assemblies"): a 4 mm cube, a 20 x 20 x 8 mm plate and a second
+// An assembly's file (docs/MESHES.md, "Assemblies"): a 4 mm cube, a 20 x 20 x 8 mm plate and a second
 // cube, bodies that share no vertex. die.part keeps one, numbered by volume, largest first, the
 // file's order breaking the cubes' tie; a part the file does not hold is refused naming the count
 // and the largest; each part is its own cache entry.
@@ -327,7 +327,7 @@ TEST(Import, AppliesDeclaredUnitAndWarnsWhenImplausible) {
   EXPECT_NE(metres.warnings[0].find("units"), std::string::npos);
 }
 
-// No unit given: the file's numbers say it (README, "Units"). A box 10 across is millimetres and
+// No unit given: the file's numbers say it (docs/MESHES.md, "Units"). A box 10 across is millimetres and
 // read silently; 2 across, inches; 0.1 across, metres; each guess other than mm is a warning.
 TEST(Import, GuessesAnUndeclaredUnitFromTheSize) {
   test::TempDir dir;

@@ -255,7 +255,7 @@ TEST(Repair, ClosesAGapNoGrainTouchesForAToolAndRefusesToJoinACavityAcrossAThinW
     EXPECT_NE(std::string(e.what()).find("where the die's wall between two parts of the cavity is thinner than 0.5 mm"),
               std::string::npos)
         << e.what();
-    // Its separate shells may be an assembly's parts, each a die of its own (README, "Assemblies").
+    // Its separate shells may be an assembly's parts, each a die of its own (docs/MESHES.md, "Assemblies").
     EXPECT_NE(std::string(e.what()).find("die.part"), std::string::npos) << e.what();
   }
 }

@@ -397,7 +397,7 @@ TEST(MpiSplit, AGrainRollingAcrossASubdomainFaceKeepsItsSpring) {
 // Memory is distributed, not replicated: 50,000 grains packed as densely as the settled packs of
 // ../shared/bench/liggghts (a lattice 2 % tighter than the grains, in a cylinder as tall as it is
 // wide) over four ranks: no rank holds more than 40 % of them, ghosts included, by its own count
-// (the 50k LIGGGHTS pack itself measured 28.8 %: README, "Over MPI ranks").
+// (the 50k LIGGGHTS pack itself measured 28.8 %: docs/MPI.md, "Over MPI ranks").
 TEST(MpiSplit, FourRanksEachHoldAtMostFortyPercentOfFiftyThousandGrains) {
   const dem::ModelSpec spec = box_spec(false);
   const double r = 0.1e-3, spacing = 1.96 * r;

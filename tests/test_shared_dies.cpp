@@ -17,7 +17,7 @@ struct SharedDie {
   const char* file;
   mesh::LengthUnit unit;  // from SOURCES.md: files store none
   const char* defect;     // nullptr: must load; else the error must name this
-  // The voxel [mm] for a file whose winding-number solid (README, "Mesh repair") is affordable
+  // The voxel [mm] for a file whose winding-number solid (docs/MESHES.md, "Mesh repair") is affordable
   // only coarser than 1/300 of the part; such a file's field is also checked against Embree's
   // ray majority on the file as it is (issue 19).
   double voxel_mm = 0;
@@ -41,13 +41,13 @@ const SharedDie shared_dies[] = {
     // Its ring gear folds through itself at a seam, in slivers microns across: welded (see
     // SharedDieCavities below). Tested as the cavity it is: where the teeth of its gears mesh
     // they stand 0.11 to 0.15 mm apart, die walls that the field keeps. (As a tool those gaps are
-    // free space narrower than a voxel, where its wall query errs by up to 2 voxels: README.)
+    // free space narrower than a voxel, where its wall query errs by up to 2 voxels: docs/MESHES.md.)
     {"planetary_gearset_vtk_gears.stl", mesh::LengthUnit::mm, nullptr, 0.714, mesh::WallRole::cavity},
     // 100 overlapping shells: 24·10⁹ winding-number terms at cells of 0.125 mm, and it is refused.
-    // At voxels of 0.9 mm it loads as a tool (472 s) and is refused as a cavity (README, "Shared
+    // At voxels of 0.9 mm it loads as a tool (472 s) and is refused as a cavity (docs/MESHES.md, "Shared
     // dies through the pipeline").
     {"toothed_pulley_hub_trimesh_cycloidal.ply", mesh::LengthUnit::in, "non-manifold edges"},
-    // One part of it, as a die is for one part (README, "Assemblies"): its 4th largest body, a
+    // One part of it, as a die is for one part (docs/MESHES.md, "Assemblies"): its 4th largest body, a
     // cycloid disc (43.4 mm across, 3.18 mm thick, lobed, 7 bores), as the cavity it would be.
     {"toothed_pulley_hub_trimesh_cycloidal.ply", mesh::LengthUnit::in, nullptr, 0.15, mesh::WallRole::cavity, 4},
     // 24 crossing shells: as a tool its winding-number solid closes the gaps between them that
@@ -159,7 +159,7 @@ INSTANTIATE_TEST_SUITE_P(All, SharedDieMesh, ::testing::ValuesIn(shared_dies),
                          });
 
 // Files store no unit: each die of the folder (not broken/) read with none given is read in the
-// unit SOURCES.md judges it to have (README, "Units").
+// unit SOURCES.md judges it to have (docs/MESHES.md, "Units").
 TEST(SharedDieUnits, AreGuessedAsTheSourcesJudgeThem) {
   REQUIRE_SHARED_MESHES();
   for (const SharedDie& d : shared_dies) {
@@ -186,7 +186,7 @@ TEST(SharedDieOpenings, AreTheFacesThatOpenTheOutline) {
 // closer than a thousandth of the tolerance removes the folds and moves nothing farther than
 // that, so it loads as a cavity with its gears apart: the walls of 0.11 to 0.15 mm between their
 // teeth stay, and with them the volume. Before, its winding-number solid joined the gears across
-// those walls, moved the surface 0.77 mm, and it was refused (README, "Shared dies through the
+// those walls, moved the surface 0.77 mm, and it was refused (docs/MESHES.md, "Shared dies through the
 // pipeline").
 TEST(SharedDieCavities, APlanetaryGearSetsSeamFoldsAreWeldedAndItsGearsStayApart) {
   REQUIRE_SHARED_MESHES();

@@ -112,7 +112,7 @@ TEST(Study, CoarseGrainingKeepsFlowAndReposeOnceTheBoundaryIsCorrected) {
   EXPECT_GT(inv["flow_rate_spread"]["measured"].get<double>(), 0.05) << inv.dump();
   // One Beverloo law makes the three rates one within the seed study's 5 %, with a k in the
   // published 1.3-2.9 (Beverloo et al. 1961; Nedderman 1992). The textbook k = 1.5 is reported,
-  // not asserted: these spheres' k is higher (README, "coarse-graining").
+  // not asserted: these spheres' k is higher (docs/STUDIES.md, "coarse-graining").
   EXPECT_LE(inv["flow_rate_spread_beverloo_fitted_k"]["measured"].get<double>(), 0.05) << inv.dump();
   const double k = r["settings"]["beverloo_k_that_makes_the_rates_one_law"];
   EXPECT_GE(k, 1.3);
