@@ -191,6 +191,9 @@ void add_calibrate(CLI::App& root, app::study::CalibrateRequest& c, std::functio
   cmd->add_option("MEASURED", c.measured, "What the lab measured (.toml: docs/INTERFACE.md, \"The measured powder\")")->required();
   cmd->add_option("-o,--out", c.out, "Output folder")->capture_default_str();
   cmd->add_flag("--resume", c.resume, "Keep the tests an interrupted calibration finished");
+  cmd->add_option("--repeats", c.repeats, "Seeds per design point: more narrow the intervals")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 50));
   cmd->add_option("--set", c.overrides, "Override a scene key of the simulated powder: --set contact.rolling=epsd");
   cmd->add_option("--threads", c.threads, "Threads (default: all cores); results do not depend on it");
   cmd->add_option("--seed", c.seed, "Random seed of the simulated tests")->capture_default_str();

@@ -41,7 +41,11 @@ void fit_map(ObservableFit& o, const std::vector<Finished>& tests, double TestRe
     y[Eigen::Index(i)] = tests[i].results.*member;
   }
   const Eigen::Vector4d b = x.colPivHouseholderQr().solve(y);
-  for (int k = 0; k < 4; ++k) o.coefficients[k] = b[k];
+  const Eigen::Matrix4d inverse = (x.transpose() * x).inverse();
+  for (int k = 0; k < 4; ++k) {
+    o.coefficients[k] = b[k];
+    for (int l = 0; l < 4; ++l) o.design_inverse[k][l] = inverse(k, l);
+  }
   const double dof = double(tests.size()) - 4;
   o.scatter = dof > 0 ? std::sqrt((x * b - y).squaredNorm() / dof) : 0;
 }
@@ -57,12 +61,15 @@ ObservableFit observable(std::string name, std::string unit, double measured, do
 
 // The three quantities, each with the lab's value and its error; the solid fraction only where
 // spheres reach it (irregular grains pack looser than any friction makes spheres pack).
-std::vector<ObservableFit> observables(const std::vector<Finished>& tests, const MeasuredPowder& m) {
+std::vector<ObservableFit> observables(const std::vector<Finished>& tests, const MeasuredPowder& m, const SimulatedTests& simulated) {
   ObservableFit repose = observable("repose angle", "°", m.repose_deg, m.repose_error_deg);
   fit_map(repose, tests, &TestResults::repose_deg);
   const double c = m.flow_rate / (m.apparent_density * beverloo_orifice(m.orifice_diameter, m.particle_diameter));
   ObservableFit flow = observable("Beverloo C of the orifice flow", "", c, c * std::hypot(m.flow_rate_error, apparent_density_error));
   fit_map(flow, tests, &TestResults::beverloo_c);
+  // C of the simulated orifice moves with k as (D − k d)^{-5/2}: k's uncertainty is the map's
+  // error as a stand-in for the lab's C (calibrate.hpp).
+  flow.model_error = c * 2.5 * beverloo_k_error / (simulated.orifice_grains - beverloo_k);
   const double phi = m.solid_fraction();
   ObservableFit packing = observable("poured solid fraction", "", phi, phi * apparent_density_error);
   fit_map(packing, tests, &TestResults::solid_fraction);
@@ -79,13 +86,25 @@ std::vector<ObservableFit> observables(const std::vector<Finished>& tests, const
   return {repose, flow, packing};
 }
 
-double weight(const ObservableFit& o) { return 1 / (o.measured_error * o.measured_error + o.scatter * o.scatter); }
+// The map's own variance at p: the tests' scatter through the design (falls with more seeds).
+double map_variance(const ObservableFit& o, const Vector2& p) {
+  const Eigen::Vector4d x(1, p[0], p[1], p[0] * p[1]);
+  double v = 0;
+  for (int k = 0; k < 4; ++k)
+    for (int l = 0; l < 4; ++l) v += x[k] * o.design_inverse[k][l] * x[l];
+  return o.scatter * o.scatter * v;
+}
+
+// The combined standard error of measured against mapped, squared, inverted.
+double weight(const ObservableFit& o, const Vector2& p) {
+  return 1 / (o.measured_error * o.measured_error + o.model_error * o.model_error + map_variance(o, p));
+}
 
 // The measurements' information about the frictions at p (Gauss-Newton's JᵀWJ).
 Matrix2 information(const std::vector<ObservableFit>& obs, const Vector2& p) {
   Matrix2 h = Matrix2::Zero();
   for (const ObservableFit& o : obs)
-    if (o.used) h += weight(o) * map_gradient(o, p).transpose() * map_gradient(o, p);
+    if (o.used) h += weight(o, p) * map_gradient(o, p).transpose() * map_gradient(o, p);
   return h;
 }
 
@@ -97,7 +116,7 @@ Vector2 best_frictions(const std::vector<ObservableFit>& obs) {
   for (int iteration = 0; iteration < 50; ++iteration) {
     Vector2 gradient = prior * (p - prior_centre);
     for (const ObservableFit& o : obs)
-      if (o.used) gradient += weight(o) * map_gradient(o, p).transpose() * (map_at(o, p) - o.measured);
+      if (o.used) gradient += weight(o, p) * map_gradient(o, p).transpose() * (map_at(o, p) - o.measured);
     const Vector2 next = (p - (information(obs, p) + prior).ldlt().solve(gradient)).cwiseMax(0.0);
     const bool settled = (next - p).norm() < 1e-9;
     p = next;
@@ -108,9 +127,9 @@ Vector2 best_frictions(const std::vector<ObservableFit>& obs) {
 
 }  // namespace
 
-CalibrationFit fit_frictions(const std::vector<Finished>& tests, const MeasuredPowder& measured) {
+CalibrationFit fit_frictions(const std::vector<Finished>& tests, const MeasuredPowder& measured, const SimulatedTests& simulated) {
   CalibrationFit fit;
-  fit.observables = observables(tests, measured);
+  fit.observables = observables(tests, measured, simulated);
   const Vector2 p = best_frictions(fit.observables);
   fit.sliding = p[0];
   fit.rolling = p[1];
@@ -135,7 +154,7 @@ CalibrationFit fit_frictions(const std::vector<Finished>& tests, const MeasuredP
   fit.inside_design = within(p[0], &DesignPoint::sliding) && within(p[1], &DesignPoint::rolling);
   for (ObservableFit& o : fit.observables) {
     o.fitted = map_at(o, p);
-    o.residual = (o.fitted - o.measured) * std::sqrt(weight(o));
+    o.residual = (o.fitted - o.measured) * std::sqrt(weight(o, p));
   }
   return fit;
 }
@@ -167,7 +186,7 @@ nlohmann::json fit_json(const CalibrationFit& fit) {
   nlohmann::json observables = nlohmann::json::array();
   for (const ObservableFit& o : fit.observables)
     observables.push_back({{"name", o.name}, {"measured", o.measured}, {"measured_error", o.measured_error}, {"used", o.used},
-                           {"left_out", o.left_out}, {"map", o.coefficients}, {"scatter", o.scatter}, {"fitted", o.fitted},
+                           {"left_out", o.left_out}, {"model_error", o.model_error}, {"map", o.coefficients}, {"scatter", o.scatter}, {"fitted", o.fitted},
                            {"residual", o.residual}});
   const auto finite_or_null = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
   return {{"sliding_friction", {{"value", fit.sliding}, {"ci95", fit.sliding_ci}, {"measurements_ci95", finite_or_null(fit.sliding_data_ci)},

@@ -25,8 +25,10 @@ struct ObservableFit {
   double measured = 0, measured_error = 0;  // the lab's value and its standard error
   bool used = true;
   std::string left_out;                     // why, when not used
+  double model_error = 0;                   // of the simulated value as a stand-in for the lab's (standard error)
   double coefficients[4] = {0, 0, 0, 0};
-  double scatter = 0;                       // of the tests about the map (the seed's noise)
+  double scatter = 0;                       // of the tests about the map (one test's noise)
+  double design_inverse[4][4] = {};         // (XᵀX)⁻¹ of the design: the map's own error at a point
   double fitted = 0;                        // the map at the calibrated frictions
   double residual = 0;                      // (fitted − measured) in combined standard errors
 };
@@ -43,7 +45,7 @@ struct CalibrationFit {
 // A parameter counts as pinned when the measurements alone fix it to this (95 %).
 inline constexpr double pinned_within = 0.05;
 
-CalibrationFit fit_frictions(const std::vector<Finished>& tests, const MeasuredPowder& measured);
+CalibrationFit fit_frictions(const std::vector<Finished>& tests, const MeasuredPowder& measured, const SimulatedTests& simulated);
 
 // OUT/calibrated.toml (the [powder] keys and the [[materials]] entry, the confidence as
 // comments), OUT/calibration.json and OUT/calibration_tests.csv; each written whole or not at all.

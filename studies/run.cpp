@@ -25,7 +25,8 @@ const std::map<std::string, StudyFunction>& studies() {
       {"stability", stability},
       {"coarse-graining", coarse_graining},
       {"speed-accuracy", speed_accuracy},
-      {"cross-validation", cross_validation}};
+      {"cross-validation", cross_validation},
+      {"calibration-round-trip", calibration_round_trip}};
   return table;
 }
 

@@ -48,6 +48,10 @@ void speed_accuracy(const PipelineScene& scene, bool reduced, Output& out);
 // scene's powder with another seed stands for the measured one.
 void cross_validation(const PipelineScene& scene, bool reduced, Output& out);
 
+// `diefill calibrate` on a twin powder measured by its own tests at another grain size and seed:
+// the frictions it recovers against the true ones (calibrate.hpp).
+void calibration_round_trip(const PipelineScene& scene, bool reduced, Output& out);
+
 // Where each method fails (time step, wall voxels, shoe speed against the skin, grains too
 // coarse for the cavity): each probed, and whether the stability checks caught it.
 void stability(const PipelineScene& scene, bool reduced, Output& out);
