@@ -20,7 +20,7 @@
 #include "dem/io.hpp"
 #include "dem/step.hpp"
 
-namespace app {
+namespace cli {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -78,9 +78,9 @@ dem::ModelSpec bed_spec(const Bed& bed) {
   m.sliding_friction = 0.5, m.rolling_friction = 0.1;
   dem::ModelSpec spec;
   spec.materials = {m};
-  spec.normal = dem::NormalLaw::hertz;
-  spec.tangential = dem::TangentialLaw::mindlin;
-  spec.rolling = dem::RollingLaw::cdt;
+  spec.law.normal = "hertz";
+  spec.law.tangential = "mindlin";
+  spec.law.rolling = "cdt";
   spec.skin = skin;
   spec.max_impact_speed = 2 * std::sqrt(3.0) * stir_speed;
   spec.gravity = dem::Vec3(0, 0, -9.81);
@@ -222,4 +222,4 @@ json run_mpi_bed(const BenchCommand& c) {
   return result;
 }
 
-}  // namespace app
+}  // namespace cli

@@ -4,9 +4,9 @@
 
 #include "cli/commands.hpp"
 
-namespace app {
+namespace cli {
 
 // Collective; the result is complete on rank 0.
 nlohmann::json run_mpi_bed(const BenchCommand& command);
 
-}  // namespace app
+}  // namespace cli

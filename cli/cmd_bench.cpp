@@ -29,7 +29,7 @@
 #include "dem/step.hpp"
 #include "mesh/die.hpp"
 
-namespace app {
+namespace cli {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -53,9 +53,9 @@ dem::Material reference_material() {
 dem::ModelSpec reference_spec() {
   dem::ModelSpec spec;
   spec.materials = {reference_material()};
-  spec.normal = dem::NormalLaw::hertz;
-  spec.tangential = dem::TangentialLaw::mindlin;
-  spec.rolling = dem::RollingLaw::cdt;
+  spec.law.normal = "hertz";
+  spec.law.tangential = "mindlin";
+  spec.law.rolling = "cdt";
   spec.time_step = 1e-6;       // as bench.in
   spec.skin = 0.25e-3;         // "neighbor 0.00025 bin"
   spec.max_impact_speed = 0.5;
@@ -303,13 +303,13 @@ int run_bench(const BenchCommand& c) {
         results["cases"].push_back(time_case(fmt::format("scaling-{}", count), model, pack, c.steps, thread_counts));
       }
     } else if (name == "run-ring") {
-      app::PipelineScene scene = load_pipeline_scene(std::nullopt, {});
+      scene::PipelineScene scene = scene::load_pipeline_scene(std::nullopt, {});
       scene.out = c.cache / "run-ring";
       const std::shared_ptr<dem::Exchange> ranks = mpi_exchange();  // split under mpirun
       if (!ranks || ranks->rank() == 0) fs::remove_all(scene.out);
       if (ranks) ranks->barrier();
       diefill::Stopwatch clock;
-      const DieRun run = run_die_fill(scene, diefill::resource_path("dies/ring.stl"), false, ranks);
+      const pipeline::DieRun run = pipeline::run_die_fill(scene, diefill::resource_path("dies/ring.stl"), false, ranks);
       results["cases"].push_back({{"name", name},
                                   {"threads", omp_get_max_threads()},
                                   {"wall_s", clock.seconds()},
@@ -329,4 +329,4 @@ int run_bench(const BenchCommand& c) {
   return 0;
 }
 
-}  // namespace app
+}  // namespace cli

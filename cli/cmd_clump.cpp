@@ -11,7 +11,7 @@
 #include "core/atomic_file.hpp"
 #include "mesh/import.hpp"
 
-namespace app {
+namespace cli {
 
 namespace fs = std::filesystem;
 
@@ -31,7 +31,7 @@ double relative_clump_cost(int spheres) {
 
 int run_clump(const ClumpCommand& c) {
   const mesh::ClumpTemplate clump =
-      build_clump({c.mesh, mesh::parse_unit(c.units, "--units"), c.tolerance, c.max_spheres, c.seed});
+      pipeline::build_clump({c.mesh, mesh::parse_unit(c.units, "--units"), c.tolerance, c.max_spheres, c.seed});
 
   // -o names the template file when it ends in .json (docs/INTERFACE.md), else a folder for it.
   const bool file = c.output.extension() == ".json";
@@ -44,11 +44,11 @@ int run_clump(const ClumpCommand& c) {
     csv += fmt::format("{},{:.6g},{:.6g},{:.4g}\n", step.spheres, step.volume_error, step.hausdorff_error,
                        relative_clump_cost(step.spheres));
   diefill::write_file_atomic(errors, csv);
-  draw_pictures({"clump", errors.string()});
+  pipeline::draw_pictures({"clump", errors.string()});
   fmt::print("{}: {} spheres, volume error {:.4f}, Hausdorff error {:.4f} (tolerance {}), equivalent diameter {:.4g} mm -> {}\n",
              c.mesh.string(), clump.spheres.size(), clump.volume_error, clump.hausdorff_error, c.tolerance,
              clump.equivalent_diameter_m * 1e3, json.string());
   return 0;
 }
 
-}  // namespace app
+}  // namespace cli

@@ -10,7 +10,7 @@
 #include "core/error.hpp"
 #include "dem/io.hpp"
 
-namespace app {
+namespace cli {
 
 int run_density(const DensityCommand& c) {
   mesh::DieOptions options = mesh::die_options_for_grains(0.5e-3, 0.25e-3);
@@ -39,24 +39,24 @@ int run_density(const DensityCommand& c) {
   sized.role = options.role;
   const mesh::PreparedDie die = mesh::prepare_die(c.die, sized, std::nullopt);
   const mesh::WallField walls = die.sdf.wall_field(die.solid);
-  DensitySettings s;
+  pipeline::DensitySettings s;
   s.voxel_m = c.voxel_mm > 0 ? c.voxel_mm * 1e-3 : 4 * r_max;
   s.method = c.method;
   s.width_m = c.width_mm * 1e-3;
   s.smoothed_width_m = c.smoothed_width_mm > 0 ? c.smoothed_width_mm * 1e-3 : r_max;  // as the pipeline: half a diameter
   s.coarse_graining = c.coarse_graining;
-  const DensityResult result = compute_density(grains, die, walls, material_density, s, c.particles.string());
+  const pipeline::DensityResult result = compute_density(grains, die, walls, material_density, s, c.particles.string());
   diefill::StagingFolder out(c.output);
-  write_density(result, out.path());
+  pipeline::write_density(result, out.path());
   nlohmann::json report = {{"die", {{"name", die.name}, {"source", die.source}, {"sha256", die.sha256}}},
                            {"particles", {{"source", c.particles.string()}, {"grains", grains.size()}}},
                            {"density", {{"voxel_m", s.voxel_m}, {"method", s.method}, {"smoothed_width_m", s.smoothed_width_m}, {"material_density", material_density},
                                         {"coarse_graining", c.coarse_graining}}},
-                           {"fill", statistics_json(result.stats)}};
+                           {"fill", pipeline::statistics_json(result.stats)}};
   if (c.fem) {
-    FemSettings fem = fem_settings(2 * r_max, s.voxel_m, c.element_size_mm * 1e-3);
+    pipeline::FemSettings fem = pipeline::fem_settings(2 * r_max, s.voxel_m, c.element_size_mm * 1e-3);
     fem.quadratic = c.elements == "quadratic";
-    report["fem"] = write_fem_outputs({grains}, die, walls, material_density, result.stats.mass_kg, fem, out.path());
+    report["fem"] = pipeline::write_fem_outputs({grains}, die, walls, material_density, result.stats.mass_kg, fem, out.path());
   }
   diefill::write_file_atomic(out / "density.json", report.dump(2) + "\n");
   out.commit();
@@ -66,4 +66,4 @@ int run_density(const DensityCommand& c) {
   return 0;
 }
 
-}  // namespace app
+}  // namespace cli

@@ -5,7 +5,7 @@
 #include "mesh/import.hpp"
 #include "mesh/shapes.hpp"
 
-namespace app {
+namespace cli {
 
 int run_die(const DieCommand& c) {
   const mesh::TriMesh die = mesh::bundled_die(c.name);
@@ -14,4 +14,4 @@ int run_die(const DieCommand& c) {
   return 0;
 }
 
-}  // namespace app
+}  // namespace cli

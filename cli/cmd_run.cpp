@@ -24,7 +24,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 
-namespace app {
+namespace cli {
 
 namespace fs = std::filesystem;
 
@@ -32,13 +32,13 @@ namespace {
 
 bool is_scene(const fs::path& p) { return p.extension() == ".toml"; }
 
-PipelineScene scene_for(const fs::path& target, const std::vector<std::string>& overrides) {
-  PipelineScene scene = is_scene(target) ? load_pipeline_scene(target, overrides) : load_pipeline_scene(std::nullopt, overrides);
+scene::PipelineScene scene_for(const fs::path& target, const std::vector<std::string>& overrides) {
+  scene::PipelineScene scene = is_scene(target) ? scene::load_pipeline_scene(target, overrides) : scene::load_pipeline_scene(std::nullopt, overrides);
   if (!is_scene(target) && !target.empty()) scene.die = target;
   return scene;
 }
 
-void apply_command_line(PipelineScene& scene, const RunCommand& c) {
+void apply_command_line(scene::PipelineScene& scene, const RunCommand& c) {
   if (!c.out.empty()) scene.out = c.out;
   if (c.threads) scene.threads = *c.threads;
   if (c.up) scene.die_up = *c.up;
@@ -92,11 +92,11 @@ std::string resume_command(const RunCommand& c, const fs::path& out) {
 
 // The scene a command's overrides and options give, with more overrides (a sweep's case, an
 // ensemble's seed) after them: --seed is simulation.seed after the --set, before those.
-PipelineScene command_scene(const RunCommand& c, const std::vector<std::string>& more) {
+scene::PipelineScene command_scene(const RunCommand& c, const std::vector<std::string>& more) {
   std::vector<std::string> overrides = c.overrides;
   if (c.seed) overrides.push_back(fmt::format("simulation.seed={}", *c.seed));
   overrides.insert(overrides.end(), more.begin(), more.end());
-  PipelineScene scene = scene_for(c.target, overrides);
+  scene::PipelineScene scene = scene_for(c.target, overrides);
   apply_command_line(scene, c);
   return scene;
 }
@@ -108,7 +108,7 @@ void refuse_beside_many_runs(const RunCommand& c, const char* option) {
                               "Give one die mesh or scene, without --sweep or --resume");
 }
 
-int finish_many_runs(const DieRun& run, const std::shared_ptr<dem::Exchange>& ranks) {
+int finish_many_runs(const pipeline::DieRun& run, const std::shared_ptr<dem::Exchange>& ranks) {
   const bool root = !ranks || ranks->rank() == 0;
   if (run.interrupted) {
     if (root) fmt::print(stderr, "interrupted; seed ensembles and ladders do not resume: rerun the command\n");
@@ -120,7 +120,7 @@ int finish_many_runs(const DieRun& run, const std::shared_ptr<dem::Exchange>& ra
 
 int run_seed_ensemble(const RunCommand& c, const std::shared_ptr<dem::Exchange>& ranks) {
   refuse_beside_many_runs(c, "--seeds");
-  return finish_many_runs(run_ensemble([&](const std::vector<std::string>& more) { return command_scene(c, more); }, *c.seeds, ranks),
+  return finish_many_runs(pipeline::run_ensemble([&](const std::vector<std::string>& more) { return command_scene(c, more); }, *c.seeds, ranks),
                           ranks);
 }
 
@@ -128,16 +128,16 @@ int run_seed_ensemble(const RunCommand& c, const std::shared_ptr<dem::Exchange>&
 int run_planned(const RunCommand& c) {
   if (fs::is_directory(c.target) || c.sweep || c.resume || c.ladder || c.seeds)
     throw diefill::InputError("--plan", "", "chooses the grain size, seeds and ladder itself", "Give --plan without --ladder, --seeds, --sweep or --resume");
-  const Plan plan = make_plan(command_scene(c, {}), {c.accuracy, parse_duration(c.budget)});
-  fmt::print("{}", plan_table(plan));
+  const pipeline::Plan plan = pipeline::make_plan(command_scene(c, {}), {c.accuracy, pipeline::parse_duration(c.budget)});
+  fmt::print("{}", pipeline::plan_table(plan));
   if (!plan.chosen)
     throw diefill::InputError("--budget", c.budget, "fits no way to the answer", "Raise --budget (`diefill plan` lists each way's time)");
-  const PlanOption& chosen = plan.options[*plan.chosen];
+  const pipeline::PlanOption& chosen = plan.options[*plan.chosen];
   RunCommand run = c;
   run.plan = false;
   // The plan sized each grain size without the grain budget: the run may take what it chose.
   std::size_t grains = command_scene(c, {}).max_grains;
-  for (const PlanLevel& l : plan.levels)
+  for (const pipeline::PlanLevel& l : plan.levels)
     if (std::find(chosen.alphas.begin(), chosen.alphas.end(), l.alpha) != chosen.alphas.end()) grains = std::max(grains, l.size.grains + 1);
   run.overrides.push_back(fmt::format("powder.max_grains={}", grains));
   if (chosen.kind == "ladder") {
@@ -158,56 +158,56 @@ int run_planned(const RunCommand& c) {
 
 int run_grain_ladder(const RunCommand& c, const std::shared_ptr<dem::Exchange>& ranks) {
   refuse_beside_many_runs(c, "--ladder");
-  Ladder ladder = parse_ladder(*c.ladder);
+  pipeline::Ladder ladder = pipeline::parse_ladder(*c.ladder);
   ladder.extrapolate_to = c.extrapolate_to;
   if (c.seeds) ladder.seeds = *c.seeds;
   if (ladder.seeds < 2)
     throw diefill::InputError("--seeds", std::to_string(ladder.seeds), "a ladder's levels need two seeds or more for their errors",
                               "Give --seeds 2 or more");
-  return finish_many_runs(run_ladder([&](const std::vector<std::string>& more) { return command_scene(c, more); }, ladder, ranks),
+  return finish_many_runs(pipeline::run_ladder([&](const std::vector<std::string>& more) { return command_scene(c, more); }, ladder, ranks),
                           ranks);
 }
 
 }  // namespace
 
 int run_plan(const PlanCommand& c) {
-  const Plan plan = make_plan(command_scene(c.run, {}), {c.run.accuracy, parse_duration(c.run.budget)});
-  fmt::print("{}", plan_table(plan));
-  if (!c.json.empty()) diefill::write_file_atomic(c.json, plan_json(plan).dump(2) + "\n");
+  const pipeline::Plan plan = pipeline::make_plan(command_scene(c.run, {}), {c.run.accuracy, pipeline::parse_duration(c.run.budget)});
+  fmt::print("{}", pipeline::plan_table(plan));
+  if (!c.json.empty()) diefill::write_file_atomic(c.json, pipeline::plan_json(plan).dump(2) + "\n");
   return 0;
 }
 
 int run_scene(const SceneCommand& c) {
   if (c.keys) {
-    fmt::print("{}", scene_keys_markdown());
+    fmt::print("{}", scene::scene_keys_markdown());
     return 0;
   }
-  if (study::is_measured_powder(c.target) && c.overrides.empty()) {
+  if (studies::is_measured_powder(c.target) && c.overrides.empty()) {
     fmt::print("# a measured powder for `diefill calibrate`, fully resolved ({})\n{}", c.target.string(),
-               study::measured_powder_toml(study::read_measured_powder(c.target)));
+               studies::measured_powder_toml(studies::read_measured_powder(c.target)));
     return 0;
   }
-  PipelineScene scene = scene_for(c.target, c.overrides);
+  scene::PipelineScene scene = scene_for(c.target, c.overrides);
   scene.force = c.force;
   // Every check a run makes before its first step but those that need the die's distance field
   // (its repair, whether grains enter it), which the run builds and caches.
-  preflight_laws(scene);
+  pipeline::preflight_laws(scene);
   std::string size;
   if (!scene.die.empty()) {
-    const DieSource die = read_die(scene, scene.die);
-    ShoePlan shoe = plan_shoe(scene, die);
-    const GrainSizing grains = size_grains(scene, shoe, die.file.name);
-    set_clearance(scene, grains, die.table_z, shoe);
-    const RunSize run = preflight(scene, die, shoe, grains);
-    refuse_oversized(scene, run, die.file.source);
-    size = describe_size(run, die.file.name);
+    const pipeline::DieSource die = pipeline::read_die(scene, scene.die);
+    pipeline::ShoePlan shoe = plan_shoe(scene, die);
+    const pipeline::GrainSizing grains = size_grains(scene, shoe, die.file.name);
+    pipeline::set_clearance(scene, grains, die.table_z, shoe);
+    const pipeline::RunSize run = preflight(scene, die, shoe, grains);
+    pipeline::refuse_oversized(scene, run, die.file.source);
+    size = pipeline::describe_size(run, die.file.name);
   }
-  fmt::print("{}{}", describe(scene), size);
+  fmt::print("{}{}", scene::describe(scene), size);
   return 0;
 }
 
 int run_pipeline(const RunCommand& c) {
-  install_interrupt_handler();
+  pipeline::install_interrupt_handler();
   // Under mpirun every rank runs this; rank 0 reports (pipeline/die_fill.hpp).
   const std::shared_ptr<dem::Exchange> ranks = mpi_exchange();
   const bool root = !ranks || ranks->rank() == 0;
@@ -221,18 +221,18 @@ int run_pipeline(const RunCommand& c) {
     if (c.resume)
       throw diefill::InputError("--sweep", "--resume", "a sweep does not resume", "Resume the interrupted case with `diefill run` and its --set");
     const auto load = [&](const std::vector<std::string>& more) { return command_scene(c, more); };
-    const std::vector<DieRun> runs = run_sweep(load, parse_sweep(*c.sweep), ranks);
+    const std::vector<pipeline::DieRun> runs = pipeline::run_sweep(load, pipeline::parse_sweep(*c.sweep), ranks);
     if (!runs.empty() && runs.back().interrupted) return diefill::exit_interrupted;
     if (root)
       fmt::print("sweep: {} runs; summary {}\n", runs.size(),
-                 (runs.front().dir.parent_path().parent_path() / ("sweep_" + parse_sweep(*c.sweep).key + ".csv")).string());
+                 (runs.front().dir.parent_path().parent_path() / ("sweep_" + pipeline::parse_sweep(*c.sweep).key + ".csv")).string());
     return 0;
   }
   if (!fs::is_directory(c.target)) {
-    const PipelineScene scene = command_scene(c, {});
+    const scene::PipelineScene scene = command_scene(c, {});
     if (scene.die.empty())
       throw diefill::InputError(c.target.string(), "die.file", "names no die", "Give [die] file = \"...\" or run a mesh");
-    const DieRun run = run_die_fill(scene, scene.die, c.resume, ranks);
+    const pipeline::DieRun run = pipeline::run_die_fill(scene, scene.die, c.resume, ranks);
     if (run.interrupted) {
       if (!root) return diefill::exit_interrupted;
       if (fs::exists(run.dir / "checkpoint.bin"))
@@ -243,12 +243,12 @@ int run_pipeline(const RunCommand& c) {
       return diefill::exit_interrupted;
     }
     if (root) fmt::print("{}: report {}\n", run.die, (run.dir / "report.json").string());
-    return stop_requested() ? diefill::exit_interrupted : 0;
+    return pipeline::stop_requested() ? diefill::exit_interrupted : 0;
   }
   // A folder: every mesh into its own folder, then a summary table.
   RunCommand folder = c;
   folder.target.clear();  // the folder holds dies, not a scene
-  const PipelineScene scene = command_scene(folder, {});
+  const scene::PipelineScene scene = command_scene(folder, {});
   std::string csv = "die,status,grains_in_cavity,fill_ratio,solid_fraction_mean,solid_fraction_std,solid_fraction_min,solid_fraction_max,message\n";
   std::string md = "| die | status | grains in cavity | fill ratio | mean | std | min | max |\n|---|---|---|---|---|---|---|---|\n";
   int refused = 0, unstable = 0;
@@ -261,9 +261,9 @@ int run_pipeline(const RunCommand& c) {
   };
   for (const fs::path& mesh : meshes_in(c.target)) {
     try {
-      const DieRun run = run_die_fill(scene, mesh, c.resume, ranks);
+      const pipeline::DieRun run = pipeline::run_die_fill(scene, mesh, c.resume, ranks);
       // Stopped while its outputs were written (the FEM hand-off): that die is done, no other starts.
-      if (run.interrupted || stop_requested()) return diefill::exit_interrupted;
+      if (run.interrupted || pipeline::stop_requested()) return diefill::exit_interrupted;
       if (!root) continue;
       const auto& fill = run.report["fill"];
       const auto value = [&](const char* key) { return fill.value(key, 0.0); };
@@ -291,7 +291,7 @@ int run_pipeline(const RunCommand& c) {
 }
 
 int run_compare(const CompareCommand& c) {
-  const nlohmann::json summary = compare_runs(c.run_a, c.run_b, c.out);
+  const nlohmann::json summary = pipeline::compare_runs(c.run_a, c.run_b, c.out);
   fmt::print("fill ratio {:.4f} (A) against {:.4f} (B): B - A = {:+.4f}; per voxel RMS difference {:.4f} over {} voxels -> {}\n",
              summary["fill"]["fill_ratio"]["a"].get<double>(), summary["fill"]["fill_ratio"]["b"].get<double>(),
              summary["fill"]["fill_ratio"]["difference"].get<double>(), summary["field"]["rms_difference"].get<double>(),
@@ -299,4 +299,4 @@ int run_compare(const CompareCommand& c) {
   return 0;
 }
 
-}  // namespace app
+}  // namespace cli

@@ -7,7 +7,7 @@
 #include "mesh/die.hpp"
 #include "mesh/verify.hpp"
 
-namespace app {
+namespace cli {
 
 int run_sdf(const SdfCommand& c) {
   const double mm = 1e-3;
@@ -87,4 +87,4 @@ int run_sdf(const SdfCommand& c) {
   return 0;
 }
 
-}  // namespace app
+}  // namespace cli

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace app {
+namespace cli {
 
 std::string version_text();
 
@@ -129,6 +129,6 @@ struct ClumpCommand {
 };
 int run_clump(const ClumpCommand& command);
 
-// `diefill study`: studies/studies.hpp (study::StudyRequest, study::run_study).
+// `diefill study`: studies/studies.hpp (studies::StudyRequest, studies::run_study).
 
-}  // namespace app
+}  // namespace cli

@@ -12,10 +12,10 @@
 
 namespace {
 
-void add_sdf(CLI::App& root, app::SdfCommand& c, std::function<int()>& action) {
+void add_sdf(CLI::App& root, cli::SdfCommand& c, std::function<int()>& action) {
   CLI::App* cmd = root.add_subcommand("sdf", "Check and repair a mesh, then write its signed-distance grid");
   cmd->add_option("MESH", c.mesh, "Mesh file (STL, OBJ, PLY, OFF, ...)")->required();
-  cmd->add_option("-o,--output", c.output, "Output .vdb file");
+  cmd->add_option("-o,--out", c.output, "Output .vdb file");
   cmd->add_option("--voxel", c.voxel_mm, "Voxel edge [mm] (default: a quarter of the grain radius)");
   cmd->add_option("--units", c.units, "Length unit of the file: mm, m, in, or auto (guessed from its size)")
       ->capture_default_str();
@@ -38,13 +38,13 @@ void add_sdf(CLI::App& root, app::SdfCommand& c, std::function<int()>& action) {
   cmd->add_option("--table-margin", c.table_margin_mm, "Die table beyond the cavity [mm]")->capture_default_str();
   cmd->add_option("--verify", c.verify, "Compare N points in the band with the exact distance");
   cmd->add_option("--seed", c.seed, "Seed of the verification points")->capture_default_str();
-  cmd->callback([&] { action = [&] { return app::run_sdf(c); }; });
+  cmd->callback([&] { action = [&] { return cli::run_sdf(c); }; });
 }
 
-void add_run(CLI::App& root, app::RunCommand& c, std::function<int()>& action) {
+void add_run(CLI::App& root, cli::RunCommand& c, std::function<int()>& action) {
   CLI::App* cmd = root.add_subcommand("run", "The whole pipeline on a die mesh, a folder of meshes, or a scene");
   cmd->add_option("TARGET", c.target, "Die mesh, folder of meshes, or scene (.toml)")->required();
-  cmd->add_option("--out", c.out, "Output folder; each die writes into OUT/<die name>/ (default out)");
+  cmd->add_option("-o,--out", c.out, "Output folder; each die writes into OUT/<die name>/ (default out)");
   cmd->add_option("--set", c.overrides, "Override a scene key: --set motion.speed=0.2");
   cmd->add_option("--threads", c.threads, "Threads (default: all cores); results do not depend on it");
   cmd->add_option("--seed", c.seed, "Random seed of the powder");
@@ -65,41 +65,41 @@ void add_run(CLI::App& root, app::RunCommand& c, std::function<int()>& action) {
   cmd->add_option("--sweep", c.sweep,
                   "Run once per value of a scene key, each into OUT/KEY=VALUE/, with a summary table and chart: "
                   "--sweep motion.speed=0.05,0.1,0.2");
-  cmd->callback([&] { action = [&] { return app::run_pipeline(c); }; });
+  cmd->callback([&] { action = [&] { return cli::run_pipeline(c); }; });
 }
 
-void add_plan(CLI::App& root, app::PlanCommand& c, std::function<int()>& action) {
+void add_plan(CLI::App& root, cli::PlanCommand& c, std::function<int()>& action) {
   CLI::App* cmd = root.add_subcommand("plan", "What each grain size would take and miss by, and the cheapest way to an accuracy");
   cmd->add_option("TARGET", c.run.target, "Die mesh or scene (.toml)")->required();
   cmd->add_option("--set", c.run.overrides, "Override a scene key");
   cmd->add_option("--accuracy", c.run.accuracy, "The standard error of the fill ratio asked for")->capture_default_str();
   cmd->add_option("--budget", c.run.budget, "The wall time allowed on this machine (90s, 30m, 2h, 1h30m)")->capture_default_str();
   cmd->add_option("--threads", c.run.threads, "Threads the runs would take (default: all cores)");
-  cmd->add_option("--out", c.run.out, "Where the runs would write (its .cache holds this machine's timings)");
+  cmd->add_option("-o,--out", c.run.out, "Where the runs would write (its .cache holds this machine's timings)");
   cmd->add_option("--json", c.json, "Also write the plan as JSON to this file");
-  cmd->callback([&] { action = [&] { return app::run_plan(c); }; });
+  cmd->callback([&] { action = [&] { return cli::run_plan(c); }; });
 }
 
-void add_scene(CLI::App& root, app::SceneCommand& c, std::function<int()>& action) {
+void add_scene(CLI::App& root, cli::SceneCommand& c, std::function<int()>& action) {
   CLI::App* cmd = root.add_subcommand("scene", "Print the fully resolved scene (every default, with its reason)");
   cmd->add_option("TARGET", c.target, "Die mesh or scene (.toml)");
   cmd->add_option("--set", c.overrides, "Override a scene key");
   cmd->add_flag("--keys", c.keys, "Print every key with its type, unit, default, range and meaning (Markdown)");
   cmd->add_flag("--force", c.force, "Accept a size over the limit, as `run --force` would");
-  cmd->callback([&] { action = [&] { return app::run_scene(c); }; });
+  cmd->callback([&] { action = [&] { return cli::run_scene(c); }; });
 }
 
-void add_simulate(CLI::App& root, app::SimulateCommand& c, std::function<int()>& action) {
+void add_simulate(CLI::App& root, cli::SimulateCommand& c, std::function<int()>& action) {
   CLI::App* cmd = root.add_subcommand("simulate", "Run a general DEM scene (explicit particles, walls, motions)");
   cmd->add_option("SCENE", c.scene, "Scene file (TOML)")->required();
-  cmd->add_option("--out", c.out, "Output folder (overrides output.directory)");
+  cmd->add_option("-o,--out", c.out, "Output folder (overrides output.directory)");
   cmd->add_option("--set", c.overrides, "Override a scene key: --set simulation.duration=0.01");
   cmd->add_option("--threads", c.threads, "Threads (default: all cores)");
   cmd->add_flag("--resume", c.resume, "Continue from the output folder's checkpoint");
-  cmd->callback([&] { action = [&] { return app::run_simulate(c); }; });
+  cmd->callback([&] { action = [&] { return cli::run_simulate(c); }; });
 }
 
-void add_bench(CLI::App& root, app::BenchCommand& c, std::function<int()>& action) {
+void add_bench(CLI::App& root, cli::BenchCommand& c, std::function<int()>& action) {
   CLI::App* cmd = root.add_subcommand("bench", "Performance cases; JSON results");
   cmd->add_option("CASE", c.cases, "ring-10k, ring-100k (default both), liggghts, scaling (tiles of the LIGGGHTS pack, 5k to 500k grains), run-ring (the default pipeline on the ring, end to end), mpi-bed (under mpirun: a bed of --grains split over the ranks, stepped to step --steps)");
   cmd->add_option("--json", c.json_out, "Write the results here instead of standard output");
@@ -112,14 +112,14 @@ void add_bench(CLI::App& root, app::BenchCommand& c, std::function<int()>& actio
   cmd->add_option("--grains", c.grains, "mpi-bed: grains in the bed")->capture_default_str();
   cmd->add_option("--checkpoint-at", c.checkpoint_at, "mpi-bed: write a checkpoint (CACHE/mpi-bed/checkpoint.bin) at this step");
   cmd->add_option("--resume", c.resume, "mpi-bed: go on from this checkpoint to --steps");
-  cmd->callback([&] { action = [&] { return app::run_bench(c); }; });
+  cmd->callback([&] { action = [&] { return cli::run_bench(c); }; });
 }
 
-void add_density(CLI::App& root, app::DensityCommand& c, std::function<int()>& action) {
+void add_density(CLI::App& root, cli::DensityCommand& c, std::function<int()>& action) {
   CLI::App* cmd = root.add_subcommand("density", "Density field of a particle file on a die");
   cmd->add_option("PARTICLES", c.particles, "Particles CSV or VTU snapshot")->required();
   cmd->add_option("--die", c.die, "The die's cavity mesh")->required();
-  cmd->add_option("-o,--output", c.output, "Output folder")->required();
+  cmd->add_option("-o,--out", c.output, "Output folder")->required();
   cmd->add_option("--units", c.units, "Length unit of the die mesh")->capture_default_str();
   cmd->add_option("--role", c.role, "cavity or container")->capture_default_str();
   cmd->add_option("--voxel", c.voxel_mm, "Voxel edge [mm] (default: four grain radii)");
@@ -139,25 +139,25 @@ void add_density(CLI::App& root, app::DensityCommand& c, std::function<int()>& a
   cmd->add_option("--elements", c.elements, "linear (C3D4) or quadratic (C3D10)")
       ->capture_default_str()
       ->check(CLI::IsMember({"linear", "quadratic"}));
-  cmd->callback([&] { action = [&] { return app::run_density(c); }; });
+  cmd->callback([&] { action = [&] { return cli::run_density(c); }; });
 }
 
-void add_compare(CLI::App& root, app::CompareCommand& c, std::function<int()>& action) {
+void add_compare(CLI::App& root, cli::CompareCommand& c, std::function<int()>& action) {
   CLI::App* cmd = root.add_subcommand("compare", "Two runs of one die side by side: fill statistics and the density difference");
   cmd->add_option("RUN_A", c.run_a, "A run's output folder (OUT/<die name>/)")->required();
   cmd->add_option("RUN_B", c.run_b, "The other run's folder; differences are B - A")->required();
-  cmd->add_option("-o,--output", c.out, "Output folder: compare.json, difference.vdb, compare.png")->required();
-  cmd->callback([&] { action = [&] { return app::run_compare(c); }; });
+  cmd->add_option("-o,--out", c.out, "Output folder: compare.json, difference.vdb, compare.png")->required();
+  cmd->callback([&] { action = [&] { return cli::run_compare(c); }; });
 }
 
-void add_die(CLI::App& root, app::DieCommand& c, std::function<int()>& action) {
+void add_die(CLI::App& root, cli::DieCommand& c, std::function<int()>& action) {
   CLI::App* cmd = root.add_subcommand("die", "Write a bundled die mesh (ring, disc, gear, slot, spline) as binary STL in mm");
   cmd->add_option("NAME", c.name, "ring, disc, gear (24 teeth, module 1.2 mm), slot (1.2 mm wide) or spline (a splined bore, ISO 14 6 x 11 x 14)")->required();
-  cmd->add_option("-o,--output", c.output, "Output STL")->required();
-  cmd->callback([&] { action = [&] { return app::run_die(c); }; });
+  cmd->add_option("-o,--out", c.output, "Output STL")->required();
+  cmd->callback([&] { action = [&] { return cli::run_die(c); }; });
 }
 
-void add_clump(CLI::App& root, app::ClumpCommand& c, std::function<int()>& action) {
+void add_clump(CLI::App& root, cli::ClumpCommand& c, std::function<int()>& action) {
   CLI::App* cmd = root.add_subcommand("clump", "Build the multi-sphere template of a grain shape, with its errors against the sphere count");
   cmd->add_option("MESH", c.mesh, "Closed grain surface mesh")->required();
   cmd->add_option("--units", c.units, "Length unit of the file: mm, m or in")->capture_default_str();
@@ -165,27 +165,27 @@ void add_clump(CLI::App& root, app::ClumpCommand& c, std::function<int()>& actio
       ->capture_default_str();
   cmd->add_option("--max-spheres", c.max_spheres, "Most spheres per grain")->capture_default_str();
   cmd->add_option("--seed", c.seed, "Seed of the surface sampling")->capture_default_str();
-  cmd->add_option("-o,--output", c.output,
+  cmd->add_option("-o,--out", c.output,
                   "The template file (ending in .json, with NAME_errors.csv and .png beside it), or a folder for NAME.json, ...")
       ->capture_default_str();
-  cmd->callback([&] { action = [&] { return app::run_clump(c); }; });
+  cmd->callback([&] { action = [&] { return cli::run_clump(c); }; });
 }
 
-void add_study(CLI::App& root, app::study::StudyRequest& c, std::function<int()>& action) {
+void add_study(CLI::App& root, studies::StudyRequest& c, std::function<int()>& action) {
   std::string names;
-  for (const std::string& name : app::study::study_names()) names += (names.empty() ? "" : ", ") + name;
+  for (const std::string& name : studies::study_names()) names += (names.empty() ? "" : ", ") + name;
   CLI::App* cmd = root.add_subcommand("study", "Calibration and method studies; CSV, JSON and PNG charts in OUT/NAME/");
   cmd->add_option("NAME", c.name, "Study: " + names)->required();
   cmd->add_option("SCENE", c.scene, "Scene (.toml) whose powder and contact laws are studied (default: the pipeline's)");
   cmd->add_option("--set", c.overrides, "Override a scene key: --set powder.coarse_graining=16");
-  cmd->add_option("--out", c.out, "Output folder")->capture_default_str();
+  cmd->add_option("-o,--out", c.out, "Output folder")->capture_default_str();
   cmd->add_flag("--reduced", c.reduced, "The small version the tests run (coarser, fewer points; minutes)");
   cmd->add_option("--threads", c.threads, "Threads (default: all cores); results do not depend on it");
   cmd->add_option("--seed", c.seed, "Random seed of the powder");
-  cmd->callback([&] { action = [&] { return app::study::run_study(c); }; });
+  cmd->callback([&] { action = [&] { return studies::run_study(c); }; });
 }
 
-void add_calibrate(CLI::App& root, app::study::CalibrateRequest& c, std::function<int()>& action) {
+void add_calibrate(CLI::App& root, studies::CalibrateRequest& c, std::function<int()>& action) {
   CLI::App* cmd = root.add_subcommand("calibrate", "Fit sliding and rolling friction to a powder's lab measurements; a [[materials]] "
                                                    "block with its confidence in OUT/calibrated.toml");
   cmd->add_option("MEASURED", c.measured, "What the lab measured (.toml: docs/INTERFACE.md, \"The measured powder\")")->required();
@@ -197,7 +197,7 @@ void add_calibrate(CLI::App& root, app::study::CalibrateRequest& c, std::functio
   cmd->add_option("--set", c.overrides, "Override a scene key of the simulated powder: --set contact.rolling=epsd");
   cmd->add_option("--threads", c.threads, "Threads (default: all cores); results do not depend on it");
   cmd->add_option("--seed", c.seed, "Random seed of the simulated tests")->capture_default_str();
-  cmd->callback([&] { action = [&] { return app::study::run_calibrate(c); }; });
+  cmd->callback([&] { action = [&] { return studies::run_calibrate(c); }; });
 }
 
 }  // namespace
@@ -209,9 +209,9 @@ int main(int argc, char** argv) {
   // millions of grains then held twice its arrays (bench/mpi_10m.sh: 1,439 against 742 bytes per
   // grain on 500,000 grains a rank).
   mallopt(M_MMAP_THRESHOLD, 1 << 20);
-  const app::MpiSession mpi(argc, argv);
+  const cli::MpiSession mpi(argc, argv);
   CLI::App root{"diefill: simulate how a powder fills a press die"};
-  root.set_version_flag("--version", [] { return app::version_text(); });
+  root.set_version_flag("--version", [] { return cli::version_text(); });
   root.require_subcommand(1);
   bool verbose = false;
   root.add_flag("-v,--verbose", verbose, "Log each stage with its time");
@@ -220,29 +220,29 @@ int main(int argc, char** argv) {
     if (verbose && diefill::log::level() != diefill::log::Level::quiet) diefill::log::set_level(diefill::log::Level::verbose);
   });
   std::function<int()> action;
-  app::SdfCommand sdf;
-  app::DieCommand die;
-  app::RunCommand run;
+  cli::SdfCommand sdf;
+  cli::DieCommand die;
+  cli::RunCommand run;
   add_run(root, run, action);
-  app::SceneCommand scene;
+  cli::SceneCommand scene;
   add_scene(root, scene, action);
-  app::PlanCommand plan;
+  cli::PlanCommand plan;
   add_plan(root, plan, action);
-  app::SimulateCommand simulate;
+  cli::SimulateCommand simulate;
   add_simulate(root, simulate, action);
-  app::BenchCommand bench;
+  cli::BenchCommand bench;
   add_bench(root, bench, action);
-  app::DensityCommand density;
+  cli::DensityCommand density;
   add_density(root, density, action);
   add_sdf(root, sdf, action);
   add_die(root, die, action);
-  app::CompareCommand compare;
+  cli::CompareCommand compare;
   add_compare(root, compare, action);
-  app::ClumpCommand clump;
+  cli::ClumpCommand clump;
   add_clump(root, clump, action);
-  app::study::StudyRequest study;
+  studies::StudyRequest study;
   add_study(root, study, action);
-  app::study::CalibrateRequest calibrate;
+  studies::CalibrateRequest calibrate;
   add_calibrate(root, calibrate, action);
   try {
     root.parse(argc, argv);
@@ -250,7 +250,7 @@ int main(int argc, char** argv) {
     const int status = root.exit(e);
     return status == 0 ? 0 : diefill::exit_bad_input;
   }
-  const std::shared_ptr<dem::Exchange> ranks = app::mpi_exchange();
+  const std::shared_ptr<dem::Exchange> ranks = cli::mpi_exchange();
   const bool split = ranks && ranks->ranks() > 1;
   if (split && !root.got_subcommand("run") && !root.got_subcommand("simulate") && !root.got_subcommand("bench")) {
     if (ranks->rank() == 0)
@@ -272,7 +272,7 @@ int main(int argc, char** argv) {
     return diefill::exit_unstable;
   } catch (const std::exception& e) {
     fmt::print(stderr, "error: {}\n", e.what());
-    if (split) app::abort_all_ranks(diefill::exit_other);
+    if (split) cli::abort_all_ranks(diefill::exit_other);
     return diefill::exit_other;
   }
 }

@@ -10,7 +10,7 @@
 #include "dem/mpi_exchange.hpp"
 #endif
 
-namespace app {
+namespace cli {
 
 namespace {
 std::shared_ptr<dem::Exchange> session_exchange;
@@ -58,4 +58,4 @@ void abort_all_ranks(int status) { std::exit(status); }
 
 std::shared_ptr<dem::Exchange> mpi_exchange() { return session_exchange; }
 
-}  // namespace app
+}  // namespace cli

@@ -6,7 +6,7 @@
 
 #include "dem/exchange.hpp"
 
-namespace app {
+namespace cli {
 
 class MpiSession {
  public:
@@ -22,4 +22,4 @@ std::shared_ptr<dem::Exchange> mpi_exchange();
 // Ends every rank of the run with `status` (an error on one rank that the others cannot know of).
 [[noreturn]] void abort_all_ranks(int status);
 
-}  // namespace app
+}  // namespace cli

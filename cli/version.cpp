@@ -4,7 +4,7 @@
 #include "core/resources.hpp"
 #include "mesh/versions.hpp"
 
-namespace app {
+namespace cli {
 
 std::string version_text() {
   return fmt::format(
@@ -13,4 +13,4 @@ std::string version_text() {
       mesh::eigen_version(), diefill::resource_path("").string());
 }
 
-}  // namespace app
+}  // namespace cli

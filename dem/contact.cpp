@@ -6,21 +6,12 @@ namespace dem {
 
 namespace {
 
-// One dimensionless collision at unit approach speed: x'' = -max(0, f(x) + damping g(x) x'),
-// with f = (4/3) x^{3/2}, g = sqrt(2) x^{1/4} for Hertz and f = x, g = 1 for the linear law
-// (time in units of sqrt(m*/k), or of the Hertz equivalent; e depends on the damping only).
-double collide(NormalLaw law, double damping) {
+// The law's f and g (contact.hpp): f = (4/3) x^{3/2}, g = sqrt(2) x^{1/4} for Hertz, f = x, g = 1
+// for the linear law; e depends on the damping only.
+double collide(double (*unit_force)(double), double (*unit_damping)(double), double damping) {
   auto accel = [&](double x, double v) {
     if (x <= 0) return 0.0;
-    double f, g;
-    if (law == NormalLaw::hertz) {
-      f = (4.0 / 3.0) * x * std::sqrt(x);
-      g = std::sqrt(2.0) * std::sqrt(std::sqrt(x));
-    } else {
-      f = x;
-      g = 1.0;
-    }
-    return -std::max(0.0, f + damping * g * v);
+    return -std::max(0.0, unit_force(x) + damping * unit_damping(x) * v);
   };
   double x = 0.0, v = 1.0;
   const double dt = 2e-4;
@@ -45,15 +36,17 @@ double collide(NormalLaw law, double damping) {
 
 }  // namespace
 
-double restitution_for_damping(NormalLaw law, double damping) { return collide(law, damping); }
+double restitution_for_damping(double (*unit_force)(double), double (*unit_damping)(double), double damping) {
+  return collide(unit_force, unit_damping, damping);
+}
 
-double damping_for_restitution(NormalLaw law, double e) {
+double damping_for_restitution(double (*unit_force)(double), double (*unit_damping)(double), double e) {
   if (e >= 1.0) return 0.0;
   double lo = 0.0, hi = 1.0;
-  while (collide(law, hi) > e) hi *= 2.0;  // restitution falls with damping
+  while (collide(unit_force, unit_damping, hi) > e) hi *= 2.0;  // restitution falls with damping
   for (int it = 0; it < 60; ++it) {
     const double mid = 0.5 * (lo + hi);
-    (collide(law, mid) > e ? lo : hi) = mid;
+    (collide(unit_force, unit_damping, mid) > e ? lo : hi) = mid;
   }
   return 0.5 * (lo + hi);
 }

@@ -2,14 +2,19 @@
 // Contact laws composed of slots (after LAMMPS GRANULAR): normal (Hertz or linear
 // spring-dashpot, each with viscous damping to a prescribed restitution), tangential (Mindlin
 // spring with history and a Coulomb cap), rolling (elastic-plastic spring or constant
-// directional torque) and cohesion (simplified JKR). Each slot is a small struct with its
-// parameters and a pure function; the force loop is instantiated once per combination in use
-// (forces.cpp), so adding a law never touches the loop. Equations: docs/PHYSICS.md §2.
+// directional torque) and cohesion (simplified JKR). Each slot's law is a small struct: a pure
+// function, and what the registry (contact_laws.hpp) reads of it: its name in scenes
+// (contact.<slot>), what it does, the scene keys it reads, and whether it keeps a history per
+// contact. The force loop is instantiated once per combination registered (forces.cpp), so adding
+// a law never touches the loop (docs/ARCHITECTURE.md, "Adding a contact law"). Equations:
+// docs/PHYSICS.md §2.
 // The laws choose by selection, not by branches: the pair loop evaluates them over batches of
 // contacts that the compiler vectorises (one contact per lane, the same IEEE operations as one
 // at a time), which a branch would forbid.
 #include <cmath>
 #include <cstdint>
+#include <numbers>
+#include <string_view>
 
 #include "dem/types.hpp"
 
@@ -29,10 +34,6 @@ struct PairParams {
   double cohesion = 0;     // SJKR cohesion energy density [J/m³ = N/m²]
 };
 
-enum class NormalLaw : std::uint8_t { hertz, linear };
-enum class TangentialLaw : std::uint8_t { mindlin, none };
-enum class RollingLaw : std::uint8_t { epsd, cdt, none };
-enum class CohesionLaw : std::uint8_t { sjkr, none };
 
 // Geometry and kinematics of one contact, from body i's point of view: n points from j to i.
 struct ContactKinematics {
@@ -57,8 +58,24 @@ struct ContactForce {
 };
 
 // ---- normal slot ------------------------------------------------------------------------
-// Returns the elastic normal force [N] and the normal stiffness S_n [N/m] at this overlap.
+// eval: the elastic normal force [N] and the normal stiffness S_n [N/m] at this overlap. Besides,
+// a normal law gives the model its time step and damping: the collision time at an impact speed,
+// the stored elastic energy, and the dimensionless collision (contact.cpp: force f(x) and damping
+// shape g(x) at overlap x, time in units of sqrt(m*/k) or its Hertz equivalent).
 struct HertzNormal {
+  static constexpr std::string_view name = "hertz", meaning = "Hertz",
+                                    reads = "materials' youngs_modulus and poisson_ratio";
+  static constexpr bool keeps_history = false;
+  // 2.9432 δmax / v, δmax = (15 m* v² / (16 E* √R*))^(2/5).
+  static double collision_time(const PairParams& p, double r_eff, double m_eff, double speed) {
+    const double overlap = std::pow(15 * m_eff * speed * speed / (16 * p.e_star * std::sqrt(r_eff)), 0.4);
+    return 2.9432 * overlap / speed;
+  }
+  static double energy(const PairParams& p, double r_eff, double overlap) {  // (8/15) E* sqrt(R*) δ^{5/2}
+    return (8.0 / 15.0) * p.e_star * std::sqrt(r_eff) * overlap * overlap * std::sqrt(overlap);
+  }
+  static double unit_force(double x) { return (4.0 / 3.0) * x * std::sqrt(x); }
+  static double unit_damping(double x) { return std::sqrt(2.0) * std::sqrt(std::sqrt(x)); }
   static void eval(const PairParams& p, const ContactKinematics& c, double& elastic, double& stiffness) {
     const double a = std::sqrt(c.r_eff * c.overlap);   // contact radius [m]
     stiffness = 2.0 * p.e_star * a;                    // S_n = 2 E* sqrt(R* δ)
@@ -66,6 +83,14 @@ struct HertzNormal {
   }
 };
 struct LinearNormal {
+  static constexpr std::string_view name = "linear", meaning = "a linear spring", reads = "contact.linear_stiffness";
+  static constexpr bool keeps_history = false;
+  static double collision_time(const PairParams& p, double, double m_eff, double) {
+    return std::numbers::pi * std::sqrt(m_eff / p.k_linear);
+  }
+  static double energy(const PairParams& p, double, double overlap) { return 0.5 * p.k_linear * overlap * overlap; }
+  static double unit_force(double x) { return x; }
+  static double unit_damping(double) { return 1.0; }
   static void eval(const PairParams& p, const ContactKinematics& c, double& elastic, double& stiffness) {
     stiffness = p.k_linear;
     elastic = p.k_linear * c.overlap;
@@ -74,7 +99,9 @@ struct LinearNormal {
 
 // ---- tangential slot --------------------------------------------------------------------
 struct MindlinTangential {
-  static constexpr bool active = true;
+  static constexpr std::string_view name = "mindlin", meaning = "a tangential spring with a Coulomb cap (Mindlin)",
+                                    reads = "materials' sliding_friction";
+  static constexpr bool keeps_history = true;  // the spring ξ
   // Tangential force on i, updating the spring ξ. S_t = 8 G* sqrt(R* δ) = (4 G*/E*) S_n, damped
   // like the normal part (γ_t = sqrt(S_t/S_n) γ_n); `normal_force` (non-negative) sets the
   // Coulomb cap.
@@ -99,7 +126,8 @@ struct MindlinTangential {
   }
 };
 struct NoTangential {
-  static constexpr bool active = false;
+  static constexpr std::string_view name = "none", meaning = "frictionless", reads = "";
+  static constexpr bool keeps_history = false;
   static Vec3 eval(const PairParams&, const ContactKinematics&, double, double, double, double, Vec3&) {
     return Vec3::Zero();
   }
@@ -108,7 +136,8 @@ struct NoTangential {
 // ---- rolling slot -----------------------------------------------------------------------
 // Torque on i opposing the relative rolling; limit μ_r R* F_n.
 struct EpsdRolling {
-  static constexpr bool active = true;
+  static constexpr std::string_view name = "epsd", meaning = "an elastic-plastic spring", reads = "materials' rolling_friction";
+  static constexpr bool keeps_history = true;  // the elastic torque
   // Elastic-plastic spring (Ai et al. 2011, type C without damping): k_r = 2.25 S_n μ_r² R*².
   static Vec3 eval(const PairParams& p, const ContactKinematics& c, double normal_force,
                    double normal_stiffness, double dt, Vec3& torque) {
@@ -123,7 +152,8 @@ struct EpsdRolling {
   }
 };
 struct CdtRolling {
-  static constexpr bool active = true;
+  static constexpr std::string_view name = "cdt", meaning = "a constant directional torque", reads = "materials' rolling_friction";
+  static constexpr bool keeps_history = false;
   // Constant directional torque (LIGGGHTS "cdt"): full limit against the rolling direction.
   static Vec3 eval(const PairParams& p, const ContactKinematics& c, double normal_force, double,
                    double, Vec3&) {
@@ -134,7 +164,8 @@ struct CdtRolling {
   }
 };
 struct NoRolling {
-  static constexpr bool active = false;
+  static constexpr std::string_view name = "none", meaning = "no resistance (spheres need one for 30-40° repose)", reads = "";
+  static constexpr bool keeps_history = false;
   static Vec3 eval(const PairParams&, const ContactKinematics&, double, double, double, Vec3&) {
     return Vec3::Zero();
   }
@@ -143,11 +174,15 @@ struct NoRolling {
 // ---- cohesion slot ----------------------------------------------------------------------
 // Simplified JKR: an attractive force k A over the Hertzian contact area A = π R* δ.
 struct SjkrCohesion {
+  static constexpr std::string_view name = "sjkr", meaning = "simplified JKR", reads = "materials' cohesion_energy_density";
+  static constexpr bool keeps_history = false;
   static double eval(const PairParams& p, const ContactKinematics& c) {
     return -p.cohesion * 3.14159265358979323846 * c.r_eff * c.overlap;
   }
 };
 struct NoCohesion {
+  static constexpr std::string_view name = "none", meaning = "no cohesion", reads = "";
+  static constexpr bool keeps_history = false;
   static double eval(const PairParams&, const ContactKinematics&) { return 0.0; }
 };
 
@@ -155,6 +190,10 @@ struct NoCohesion {
 // rolling, in that order.
 template <class Normal, class Tangential, class Rolling, class Cohesion>
 struct ContactLaw {
+  using NormalSlot = Normal;
+  // The histories the pair loop gathers and stores (only those, contact.hpp's ContactHistory).
+  static constexpr bool keeps_tangential = Tangential::keeps_history, keeps_rolling = Rolling::keeps_history;
+  static_assert(!Normal::keeps_history && !Cohesion::keeps_history, "a contact keeps a tangential and a rolling history only");
   static ContactForce eval(const PairParams& p, const ContactKinematics& c, double dt,
                            ContactHistory& h) {
     double elastic, stiffness;
@@ -173,10 +212,11 @@ struct ContactLaw {
   }
 };
 
-// Damping ratio γ / sqrt(S_n m*) that makes a collision under `law` end with restitution `e`,
-// found by integrating the dimensionless collision (with the no-pull clamp) and bisection.
-double damping_for_restitution(NormalLaw law, double e);
-// The restitution a damping ratio gives (the forward map, exposed for tests).
-double restitution_for_damping(NormalLaw law, double damping);
+// The restitution a damping ratio gives under a normal law: one dimensionless collision at unit
+// approach speed, x'' = -max(0, f(x) + damping g(x) x'), integrated (with the no-pull clamp).
+double restitution_for_damping(double (*unit_force)(double), double (*unit_damping)(double), double damping);
+// Its inverse by bisection: the damping ratio γ / sqrt(S_n m*) that makes a collision end with
+// restitution `e`.
+double damping_for_restitution(double (*unit_force)(double), double (*unit_damping)(double), double e);
 
 }  // namespace dem

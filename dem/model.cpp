@@ -1,7 +1,9 @@
 #include "dem/model.hpp"
 
 #include <fmt/core.h>
+#include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -42,10 +44,26 @@ double rayleigh_time(const Material& m, double radius) {
          (0.1631 * m.poisson_ratio + 0.8766);
 }
 
-// Hertz collision time at impact speed v: 2.9432 δmax / v, δmax = (15 m* v² / (16 E* √R*))^(2/5).
-double hertz_time(double e_star, double r_eff, double m_eff, double v) {
-  const double overlap = std::pow(15 * m_eff * v * v / (16 * e_star * std::sqrt(r_eff)), 0.4);
-  return 2.9432 * overlap / v;
+// The registry's combination of the scene's four laws, or an error naming the slot whose law is
+// unknown, with the ones there are.
+const CompiledContactLaw& contact_law_of(const ContactLawChoice& choice, const std::string& source) {
+  for (std::size_t k = 0; k < law_slot_names.size(); ++k) {
+    const auto slot = LawSlot(k);
+    const std::vector<std::string_view> names = slot_law_names(slot);
+    if (std::find(names.begin(), names.end(), choice[slot]) == names.end())
+      throw InputError(source, fmt::format("contact.{}", law_slot_names[k]), fmt::format("no {} law is called \"{}\"", law_slot_names[k], choice[slot]),
+                       fmt::format("Name one of: {}", fmt::join(names, ", ")));
+  }
+  if (const CompiledContactLaw* law = find_contact_law(choice)) return *law;
+  throw InputError(source, "contact", fmt::format("the laws {} + {} + {} + {} are not compiled together", choice.normal, choice.tangential, choice.rolling, choice.cohesion),
+                   "Register the combination (docs/ARCHITECTURE.md, \"Adding a contact law\")");
+}
+
+// Whether one of the laws declares that it reads this scene key.
+bool reads_key(const ContactLawChoice& choice, std::string_view key) {
+  for (const SlotLaw& law : slot_laws())
+    if (choice[law.slot] == law.name && law.reads.find(key) != std::string_view::npos) return true;
+  return false;
 }
 
 }  // namespace
@@ -59,16 +77,15 @@ Model compile_model(const ModelSpec& spec, const State& state, const std::string
     if (state.material[i] < 0 || state.material[i] >= nm)
       throw InputError(source, "particles.material", fmt::format("grain {} names material {} of {}", state.id[i], state.material[i], nm),
                        "Give every grain a defined material");
-  if (spec.normal == NormalLaw::linear && !(spec.linear_stiffness > 0))
-    throw InputError(source, "contact.linear_stiffness", "the linear normal law needs a positive stiffness [N/m]",
+  const CompiledContactLaw& law = contact_law_of(spec.law, source);
+  if (reads_key(spec.law, "contact.linear_stiffness") && !(spec.linear_stiffness > 0))
+    throw InputError(source, "contact.linear_stiffness", fmt::format("the {} normal law needs a positive stiffness [N/m]", spec.law.normal),
                      "Set contact.linear_stiffness");
 
   Model m;
   m.materials = spec.materials;
-  m.normal = spec.normal;
-  m.tangential = spec.tangential;
-  m.rolling = spec.rolling;
-  m.cohesion = spec.cohesion;
+  m.law = spec.law;
+  m.contact_law = &law;
   m.gravity = spec.gravity;
   m.domain = spec.domain;
   m.planes = spec.planes;
@@ -110,7 +127,7 @@ Model compile_model(const ModelSpec& spec, const State& state, const std::string
       if (!(p.restitution > 0 && p.restitution <= 1))
         throw InputError(source, "interactions.restitution", "must lie in (0, 1]", "Correct the interaction");
       auto it = damping_of.find(p.restitution);
-      if (it == damping_of.end()) it = damping_of.emplace(p.restitution, damping_for_restitution(m.normal, p.restitution)).first;
+      if (it == damping_of.end()) it = damping_of.emplace(p.restitution, damping_for_restitution(law.unit_force, law.unit_damping, p.restitution)).first;
       p.damping = it->second;
       m.pair_table[std::size_t(a * nm + b)] = p;
     }
@@ -131,11 +148,7 @@ Model compile_model(const ModelSpec& spec, const State& state, const std::string
       const double v = std::max(spec.max_impact_speed, 1e-3);
       // Against an equal grain, and against a wall (R* = r, m* = m).
       const double r = state.radius[i], mass = state.mass[i];
-      if (m.normal == NormalLaw::hertz) {
-        m.dt_hertz = std::min({m.dt_hertz, hertz_time(p.e_star, r / 2, mass / 2, v), hertz_time(p.e_star, r, mass, v)});
-      } else {
-        m.dt_hertz = std::min(m.dt_hertz, std::numbers::pi * std::sqrt(0.5 * mass / p.k_linear));
-      }
+      m.dt_hertz = std::min({m.dt_hertz, law.collision_time(p, r / 2, mass / 2, v), law.collision_time(p, r, mass, v)});
     }
   }
   // Split over ranks, each holds some of the grains: the time step is the whole scene's.
@@ -172,9 +185,9 @@ Model compile_model(const ModelSpec& spec, const State& state, const std::string
   }
   m.cell_size = 2 * m.max_radius + m.skin;
 
-  std::string text = fmt::format("dt={:a};skin={:a};g={:a},{:a},{:a};laws={},{},{},{};stop={:a};dom={:a},{:a},{:a},{:a},{:a},{:a}",
-                                 m.dt, m.skin, m.gravity.x(), m.gravity.y(), m.gravity.z(), int(m.normal),
-                                 int(m.tangential), int(m.rolling), int(m.cohesion), m.stop_overlap,
+  std::string text = fmt::format("dt={:a};skin={:a};g={:a},{:a},{:a};laws={}+{}+{}+{};stop={:a};dom={:a},{:a},{:a},{:a},{:a},{:a}",
+                                 m.dt, m.skin, m.gravity.x(), m.gravity.y(), m.gravity.z(), m.law.normal,
+                                 m.law.tangential, m.law.rolling, m.law.cohesion, m.stop_overlap,
                                  m.domain.lo.x(), m.domain.lo.y(), m.domain.lo.z(), m.domain.hi.x(),
                                  m.domain.hi.y(), m.domain.hi.z());
   for (const PairParams& p : m.pair_table)

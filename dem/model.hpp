@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "dem/contact.hpp"
+#include "dem/contact_laws.hpp"
 #include "dem/motion.hpp"
 #include "dem/types.hpp"
 #include "mesh/wall_field.hpp"
@@ -80,10 +81,7 @@ struct Box3 {
 struct ModelSpec {
   std::vector<Material> materials;
   std::vector<Interaction> interactions;
-  NormalLaw normal = NormalLaw::hertz;
-  TangentialLaw tangential = TangentialLaw::mindlin;
-  RollingLaw rolling = RollingLaw::none;
-  CohesionLaw cohesion = CohesionLaw::none;
+  ContactLawChoice law;  // by name, from the registry (contact_laws.hpp)
   Vec3 gravity = Vec3(0, 0, -9.81);
   std::optional<double> time_step;    // [s]; automatic when absent
   double time_step_fraction = 0.15;   // of the smaller of the Rayleigh and Hertz times
@@ -99,10 +97,8 @@ struct ModelSpec {
 struct Model {
   std::vector<Material> materials;
   std::vector<PairParams> pair_table;  // [materials²], symmetric
-  NormalLaw normal;
-  TangentialLaw tangential;
-  RollingLaw rolling;
-  CohesionLaw cohesion;
+  ContactLawChoice law;
+  const CompiledContactLaw* contact_law = nullptr;  // its kernels, from the registry
   Vec3 gravity;
   double dt;                    // [s]
   double dt_rayleigh;           // [s] smallest Rayleigh time of the particles

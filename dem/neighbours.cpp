@@ -299,7 +299,7 @@ void rebuild_neighbours(const Model& model, State& s) {
   // The old pairs' histories come from the list (or, split over ranks, with the grains, by global
   // id: exchange.hpp), matched to the new list's pairs below.
   NeighbourList& nl = s.neighbours;
-  const bool tangential = model.tangential != TangentialLaw::none, rolling = model.rolling == RollingLaw::epsd;
+  const bool tangential = model.contact_law->keeps_tangential, rolling = model.contact_law->keeps_rolling;
   const Array<std::int32_t> old_near = nl.near_wall;
   const Array<WallSlot> old_slots = std::move(s.wall_slots);
 

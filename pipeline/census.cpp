@@ -8,7 +8,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 
-namespace app {
+namespace pipeline {
 
 using dem::Vec3;
 
@@ -114,4 +114,4 @@ void check_losses(const Census& c, const std::string& die_source, const std::str
                        die_name, c.in_shoe, c.grains, c.in_cavity);
 }
 
-}  // namespace app
+}  // namespace pipeline

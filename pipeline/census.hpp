@@ -11,7 +11,7 @@
 #include "pipeline/plan.hpp"
 #include "postprocess/field.hpp"
 
-namespace app {
+namespace pipeline {
 
 struct Census {
   std::size_t inserted = 0;  // by the insertion, not by this count: the two are checked against each other
@@ -33,4 +33,4 @@ Census count_grains(const dem::State& state, std::size_t inserted, double table_
 // ran out of powder.
 void check_losses(const Census& census, const std::string& die_source, const std::string& die_name);
 
-}  // namespace app
+}  // namespace pipeline

@@ -4,7 +4,7 @@
 #include "mesh/import.hpp"
 #include "mesh/repair.hpp"
 
-namespace app {
+namespace pipeline {
 
 mesh::ClumpTemplate build_clump(const ClumpRequest& request) {
   const mesh::ImportResult imported = mesh::import_mesh(request.mesh, {request.unit});
@@ -18,4 +18,4 @@ mesh::ClumpTemplate build_clump(const ClumpRequest& request) {
   return mesh::make_clump(repaired.mesh, options);
 }
 
-}  // namespace app
+}  // namespace pipeline

@@ -8,7 +8,7 @@
 #include "mesh/clump.hpp"
 #include "mesh/trimesh.hpp"
 
-namespace app {
+namespace pipeline {
 
 struct ClumpRequest {
   std::filesystem::path mesh;
@@ -21,4 +21,4 @@ struct ClumpRequest {
 // Throws InputError for a mesh that cannot be repaired or a tolerance the spheres cannot meet.
 mesh::ClumpTemplate build_clump(const ClumpRequest& request);
 
-}  // namespace app
+}  // namespace pipeline

@@ -12,7 +12,7 @@
 #include "pipeline/pictures.hpp"
 #include "postprocess/field.hpp"
 
-namespace app {
+namespace pipeline {
 
 namespace fs = std::filesystem;
 
@@ -169,4 +169,4 @@ nlohmann::json compare_runs(const fs::path& run_a, const fs::path& run_b, const 
   return summary;
 }
 
-}  // namespace app
+}  // namespace pipeline

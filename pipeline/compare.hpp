@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
-namespace app {
+namespace pipeline {
 
 // Reads RUN_A and RUN_B (folders a run wrote: report.json and density.vdb) and writes into `out`
 // compare.json (the summary it returns), difference.vdb (B - A of the solid fraction, and of the
@@ -13,4 +13,4 @@ namespace app {
 nlohmann::json compare_runs(const std::filesystem::path& run_a, const std::filesystem::path& run_b,
                             const std::filesystem::path& out);
 
-}  // namespace app
+}  // namespace pipeline

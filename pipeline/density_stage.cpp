@@ -9,7 +9,7 @@
 #include "pipeline/pictures.hpp"
 #include "postprocess/ensemble_stats.hpp"
 
-namespace app {
+namespace pipeline {
 
 namespace fs = std::filesystem;
 
@@ -220,4 +220,4 @@ void write_density(const DensityResult& r, const fs::path& dir, bool pictures) {
   if (pictures) draw_pictures({"density", dir.string()});
 }
 
-}  // namespace app
+}  // namespace pipeline

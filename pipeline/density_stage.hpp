@@ -12,7 +12,7 @@
 #include "mesh/die.hpp"
 #include "postprocess/field.hpp"
 
-namespace app {
+namespace pipeline {
 
 struct DensitySettings {
   double voxel_m = 1e-3;           // density voxel edge
@@ -58,4 +58,4 @@ nlohmann::json statistics_json(const post::FieldStatistics& stats);
 // density.vdb, density.vti, plot_data.json and the pictures into `dir` (a staging folder).
 void write_density(const DensityResult& result, const std::filesystem::path& dir, bool pictures = true);
 
-}  // namespace app
+}  // namespace pipeline

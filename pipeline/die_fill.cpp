@@ -10,35 +10,22 @@
 #include "pipeline/outputs.hpp"
 #include "pipeline/plan.hpp"
 #include "pipeline/preflight.hpp"
+#include "pipeline/run_loop.hpp"
 #include "pipeline/shoe_fill.hpp"
 #include "pipeline/shoe_pass.hpp"
 #include "pipeline/throughput.hpp"
 #include "pipeline/walls.hpp"
 
-namespace app {
+namespace pipeline {
 
 namespace fs = std::filesystem;
 
 namespace {
 
-// The scene's thread count for the run's duration (0: leave it), restored afterwards so that a
-// process running several dies or studies keeps its own setting.
-class ThreadCount {
- public:
-  explicit ThreadCount(int threads) : saved_(omp_get_max_threads()) {
-    if (threads > 0) omp_set_num_threads(threads);
-  }
-  ~ThreadCount() { omp_set_num_threads(saved_); }
-  ThreadCount(const ThreadCount&) = delete;
-  ThreadCount& operator=(const ThreadCount&) = delete;
-
- private:
-  int saved_;
-};
 
 // Split over ranks, rank 0 prepares the walls first (building the fields into the cache) and the
 // others then read them from it; a failure on any rank stops every rank.
-FillWalls walls_rank0_first(const PipelineScene& s, const DieSource& source, const GrainSizing& grains, const ShoePlan& shoe,
+FillWalls walls_rank0_first(const scene::PipelineScene& s, const DieSource& source, const GrainSizing& grains, const ShoePlan& shoe,
                             const std::shared_ptr<dem::Exchange>& ranks) {
   if (!ranks || ranks->ranks() == 1) return prepare_walls(s, source, grains, shoe);
   FillWalls walls;
@@ -51,7 +38,7 @@ FillWalls walls_rank0_first(const PipelineScene& s, const DieSource& source, con
 
 }  // namespace
 
-FillSetup set_up_fill(const PipelineScene& s, const fs::path& die_mesh, const std::shared_ptr<dem::Exchange>& ranks) {
+FillSetup set_up_fill(const scene::PipelineScene& s, const fs::path& die_mesh, const std::shared_ptr<dem::Exchange>& ranks) {
   DieSource source = read_die(s, die_mesh);
   ShoePlan shoe = plan_shoe(s, source);
   const GrainSizing grains = size_grains(s, shoe, source.file.name);
@@ -61,7 +48,7 @@ FillSetup set_up_fill(const PipelineScene& s, const fs::path& die_mesh, const st
   return {std::move(source), std::move(shoe), grains, std::move(walls)};
 }
 
-DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resume, const std::shared_ptr<dem::Exchange>& ranks) {
+DieRun run_die_fill(const scene::PipelineScene& s, const fs::path& die_mesh, bool resume, const std::shared_ptr<dem::Exchange>& ranks) {
   diefill::Stopwatch clock;
   const ThreadCount threads(s.threads);
   if (s.max_steps > 0)
@@ -97,4 +84,4 @@ DieRun run_die_fill(const PipelineScene& s, const fs::path& die_mesh, bool resum
   return run;
 }
 
-}  // namespace app
+}  // namespace pipeline

@@ -14,7 +14,7 @@
 #include "postprocess/density.hpp"
 #include "scene/pipeline_scene.hpp"
 
-namespace app {
+namespace pipeline {
 
 struct DieRun {
   std::string die;           // name
@@ -35,13 +35,13 @@ struct FillSetup {
   GrainSizing grains;
   FillWalls walls;
 };
-FillSetup set_up_fill(const PipelineScene& scene, const std::filesystem::path& die_mesh,
+FillSetup set_up_fill(const scene::PipelineScene& scene, const std::filesystem::path& die_mesh,
                       const std::shared_ptr<dem::Exchange>& ranks = nullptr);
 
 // Throws InputError for bad input and StabilityError when the run stops on a stability check.
 // Split over MPI ranks (every rank calls it with the session's exchange), rank 0 writes the
 // outputs and returns the report; the others return an empty one.
-DieRun run_die_fill(const PipelineScene& scene, const std::filesystem::path& die_mesh, bool resume,
+DieRun run_die_fill(const scene::PipelineScene& scene, const std::filesystem::path& die_mesh, bool resume,
                     const std::shared_ptr<dem::Exchange>& ranks = nullptr);
 
-}  // namespace app
+}  // namespace pipeline

@@ -16,7 +16,7 @@
 #include "pipeline/sweep.hpp"
 #include "postprocess/ensemble_stats.hpp"
 
-namespace app {
+namespace pipeline {
 
 namespace fs = std::filesystem;
 
@@ -120,14 +120,14 @@ nlohmann::json ensemble_report(const std::vector<DieRun>& runs, const FillProduc
 }
 
 // The ensemble's outputs into `dir`, from the seeds' runs (rank 0's, which holds their grains).
-nlohmann::json write_ensemble(const PipelineScene& first, const std::vector<DieRun>& runs, const std::vector<std::string>& seeds,
+nlohmann::json write_ensemble(const scene::PipelineScene& first, const std::vector<DieRun>& runs, const std::vector<std::string>& seeds,
                               const diefill::Stopwatch& clock, const fs::path& dir) {
   for (std::size_t k = 0; k < runs.size(); ++k)
     if (runs[k].cavity_grains.empty())
       throw diefill::InputError(runs[k].dir.string(), "particles.in_cavity", fmt::format("seed {} put no grain into the cavity", seeds[k]),
                                 "Look at that seed's run: an ensemble of it has no mean field");
   // The seeds' setting, as the sweep ran them (one cache), from the cache the runs filled.
-  PipelineScene scene = first;
+  scene::PipelineScene scene = first;
   if (scene.cache.empty()) scene.cache = first.out / ".cache";
   const FillSetup setup = set_up_fill(scene, scene.die);
   Realisations realisations;
@@ -135,7 +135,7 @@ nlohmann::json write_ensemble(const PipelineScene& first, const std::vector<DieR
   diefill::StagingFolder out(dir);
   const FillProducts products = write_fill_products({scene, setup.walls, setup.grains, setup.shoe}, realisations, out.path());
   const nlohmann::json report = ensemble_report(runs, products, seeds, clock.seconds());
-  diefill::write_file_atomic(out / "scene.toml", describe(scene));
+  diefill::write_file_atomic(out / "scene.toml", scene::describe(scene));
   diefill::write_file_atomic(out / "report.json", report.dump(2) + "\n");
   out.commit();
   diefill::log::info("{}: {} seeds, fill ratio {:.4f} ± {:.4f} (standard error) -> {}", runs.front().die, seeds.size(),
@@ -145,13 +145,13 @@ nlohmann::json write_ensemble(const PipelineScene& first, const std::vector<DieR
 
 }  // namespace
 
-DieRun run_ensemble(const std::function<PipelineScene(const std::vector<std::string>& overrides)>& load, int seeds,
+DieRun run_ensemble(const std::function<scene::PipelineScene(const std::vector<std::string>& overrides)>& load, int seeds,
                     const std::shared_ptr<dem::Exchange>& ranks) {
   if (seeds < 2)
     throw diefill::InputError("--seeds", "", fmt::format("an ensemble needs two seeds or more, not {}", seeds),
                               "Give --seeds 2 or more, or leave it out for one run");
   diefill::Stopwatch clock;
-  const PipelineScene first = load({});
+  const scene::PipelineScene first = load({});
   std::vector<std::string> values;
   for (int k = 0; k < seeds; ++k) values.push_back(std::to_string(first.seed + std::uint64_t(k)));
   const std::vector<DieRun> runs = run_sweep(load, {"simulation.seed", values}, ranks);
@@ -166,4 +166,4 @@ DieRun run_ensemble(const std::function<PipelineScene(const std::vector<std::str
   return ensemble;
 }
 
-}  // namespace app
+}  // namespace pipeline

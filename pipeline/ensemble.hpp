@@ -15,7 +15,7 @@
 #include "pipeline/die_fill.hpp"
 #include "pipeline/fill_curve.hpp"
 
-namespace app {
+namespace pipeline {
 
 // Over blocks of one shape (each seed's report `fill`, say): every number their mean and, beside
 // each number that differs between them, `<key>_stderr`, the standard error of that mean; arrays
@@ -32,7 +32,7 @@ std::pair<std::vector<FillSample>, FillBand> mean_curve(const std::vector<std::v
 // and their standard errors, report.json (each varying figure the mean with `_stderr` beside
 // it, and an `ensemble` block), fill_curve.csv with its band, fem/ with each element's mean and
 // standard error, the pictures. InputError for N < 2. Interrupted when a seed's run was.
-DieRun run_ensemble(const std::function<PipelineScene(const std::vector<std::string>& overrides)>& load, int seeds,
+DieRun run_ensemble(const std::function<scene::PipelineScene(const std::vector<std::string>& overrides)>& load, int seeds,
                     const std::shared_ptr<dem::Exchange>& ranks);
 
-}  // namespace app
+}  // namespace pipeline

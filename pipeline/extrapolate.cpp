@@ -6,7 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 
-namespace app {
+namespace pipeline {
 
 double AffineFit::stderr_at(double d) const {
   return std::sqrt(std::max(0.0, var_intercept + 2 * d * covariance + d * d * var_slope));
@@ -91,4 +91,4 @@ std::string refuse_curved(const AffineFit& fit) {
                      fit.chi2, fit.dof, limit);
 }
 
-}  // namespace app
+}  // namespace pipeline

@@ -7,7 +7,7 @@
 
 #include "mesh/feature_width.hpp"
 
-namespace app {
+namespace pipeline {
 
 // One level: its grain diameter, its seeds' mean of a figure and that mean's standard error.
 struct LevelValue {
@@ -57,4 +57,4 @@ std::string refuse_curved(const AffineFit& fit);
 inline constexpr double grains_across_needed = 5;   // docs/PHYSICS.md §4.1
 inline constexpr double thin_share_allowed = 0.1;
 
-}  // namespace app
+}  // namespace pipeline

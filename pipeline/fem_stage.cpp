@@ -14,7 +14,7 @@
 #include "postprocess/compaction.hpp"
 #include "postprocess/ensemble_stats.hpp"
 
-namespace app {
+namespace pipeline {
 
 namespace fs = std::filesystem;
 
@@ -138,4 +138,4 @@ nlohmann::json write_fem_outputs(const std::vector<std::vector<post::Grain>>& re
   return j;
 }
 
-}  // namespace app
+}  // namespace pipeline

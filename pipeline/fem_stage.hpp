@@ -10,7 +10,7 @@
 #include "mesh/die.hpp"
 #include "postprocess/density.hpp"
 
-namespace app {
+namespace pipeline {
 
 // What the hand-off promises: its elements hold the cavity's mass (fill.mass_kg) to 0.5 %, measured
 // before any correction (there is none); a run that misses it says so (stability.checks).
@@ -36,4 +36,4 @@ nlohmann::json write_fem_outputs(const std::vector<std::vector<post::Grain>>& re
                                  const mesh::WallField& walls, double material_density, double mass_in_cavity_kg,
                                  const FemSettings& settings, const std::filesystem::path& dir);
 
-}  // namespace app
+}  // namespace pipeline

@@ -8,7 +8,7 @@
 #include "core/atomic_file.hpp"
 #include "pipeline/census.hpp"
 
-namespace app {
+namespace pipeline {
 
 namespace {
 
@@ -78,4 +78,4 @@ void write_fill_curve(const std::vector<FillSample>& curve, double capacity_kg, 
   diefill::write_file_atomic(csv, text);
 }
 
-}  // namespace app
+}  // namespace pipeline

@@ -8,7 +8,7 @@
 #include "dem/state.hpp"
 #include "pipeline/plan.hpp"
 
-namespace app {
+namespace pipeline {
 
 struct FillSample {
   double time = 0;            // [s]
@@ -40,4 +40,4 @@ struct FillBand {
 void write_fill_curve(const std::vector<FillSample>& curve, double capacity_kg, const std::filesystem::path& csv,
                       const FillBand* band = nullptr);
 
-}  // namespace app
+}  // namespace pipeline

@@ -16,7 +16,7 @@
 #include "pipeline/pictures.hpp"
 #include "postprocess/field.hpp"
 
-namespace app {
+namespace pipeline {
 
 namespace fs = std::filesystem;
 
@@ -54,23 +54,23 @@ struct Level {
 // Every level's scene: its α, the finest level's density voxels and elements (unless the scene
 // gives its own), so that every level lies on one grid (grid_covering depends on the die, the
 // voxel and its anchor alone), and its own folder.
-PipelineScene level_scene(const std::function<PipelineScene(const std::vector<std::string>&)>& load, double alpha, double finest,
+scene::PipelineScene level_scene(const std::function<scene::PipelineScene(const std::vector<std::string>&)>& load, double alpha, double finest,
                           const std::vector<std::string>& more) {
-  const PipelineScene plain = load({});
+  const scene::PipelineScene plain = load({});
   std::vector<std::string> overrides = {fmt::format("powder.coarse_graining={}", alpha)};
   if (plain.density_voxel == 0) overrides.push_back(fmt::format("density.voxel={}", 2 * finest));
   if (plain.fem_element_size == 0) overrides.push_back(fmt::format("fem.element_size={}", 2 * finest));
   overrides.insert(overrides.end(), more.begin(), more.end());
-  PipelineScene s = load(overrides);
+  scene::PipelineScene s = load(overrides);
   s.out = plain.out / fmt::format("powder.coarse_graining={}", alpha);
   if (s.cache.empty()) s.cache = plain.out / ".cache";  // one die field and settled shoes for every level
   return s;
 }
 
 // Refusals before any run: a level the shoe's grain budget would coarsen, and features too thin.
-void check_levels(const std::function<PipelineScene(const std::vector<std::string>&)>& load, const Ladder& ladder, double finest) {
+void check_levels(const std::function<scene::PipelineScene(const std::vector<std::string>&)>& load, const Ladder& ladder, double finest) {
   for (double alpha : ladder.alphas) {
-    const PipelineScene s = level_scene(load, alpha, finest, {});
+    const scene::PipelineScene s = level_scene(load, alpha, finest, {});
     const DieSource die = read_die(s, s.die);
     const GrainSizing grains = size_grains(s, plan_shoe(s, die), die.file.name);
     if (std::abs(grains.alpha - alpha) > 1e-9 * alpha)
@@ -79,7 +79,7 @@ void check_levels(const std::function<PipelineScene(const std::vector<std::strin
                                             s.max_grains),
                                 "Raise powder.max_grains, or give coarser levels");
   }
-  const PipelineScene coarsest = level_scene(load, ladder.alphas.front(), finest, {});
+  const scene::PipelineScene coarsest = level_scene(load, ladder.alphas.front(), finest, {});
   const DieSource die = read_die(coarsest, coarsest.die);
   const double d = coarsest.grain_diameter();
   const mesh::Box box = mesh::bounding_box(die.file.mesh);
@@ -187,9 +187,9 @@ std::string write_extrapolation(const std::vector<Level>& levels, const Ladder& 
 
 }  // namespace
 
-DieRun run_ladder(const std::function<PipelineScene(const std::vector<std::string>& overrides)>& load, const Ladder& ladder,
+DieRun run_ladder(const std::function<scene::PipelineScene(const std::vector<std::string>& overrides)>& load, const Ladder& ladder,
                   const std::shared_ptr<dem::Exchange>& ranks) {
-  const PipelineScene plain = load({});
+  const scene::PipelineScene plain = load({});
   const double finest = ladder.alphas.back() * plain.particle_diameter;
   check_levels(load, ladder, finest);
   std::vector<Level> levels;
@@ -218,4 +218,4 @@ DieRun run_ladder(const std::function<PipelineScene(const std::vector<std::strin
   return out;
 }
 
-}  // namespace app
+}  // namespace pipeline

@@ -13,7 +13,7 @@
 #include "dem/exchange.hpp"
 #include "pipeline/die_fill.hpp"
 
-namespace app {
+namespace pipeline {
 
 struct Ladder {
   std::vector<double> alphas;            // coarse-graining levels, three or more, distinct
@@ -31,7 +31,7 @@ Ladder parse_ladder(const std::string& text);
 // extrapolated solid fraction and its standard error per voxel), ladder.csv and
 // extrapolation.png. Levels off the line beyond their noise: the outputs are written, the
 // block says why, and InputError follows.
-DieRun run_ladder(const std::function<PipelineScene(const std::vector<std::string>& overrides)>& load, const Ladder& ladder,
+DieRun run_ladder(const std::function<scene::PipelineScene(const std::vector<std::string>& overrides)>& load, const Ladder& ladder,
                   const std::shared_ptr<dem::Exchange>& ranks);
 
-}  // namespace app
+}  // namespace pipeline

@@ -19,13 +19,13 @@
 #include "pipeline/pictures.hpp"
 #include "scene/physics_keys.hpp"
 
-namespace app {
+namespace pipeline {
 
 namespace fs = std::filesystem;
 
 namespace {
 
-DensitySettings density_settings(const PipelineScene& scene, const GrainSizing& grains) {
+DensitySettings density_settings(const scene::PipelineScene& scene, const GrainSizing& grains) {
   DensitySettings ds;
   ds.voxel_m = scene.density_voxel > 0 ? scene.density_voxel : 2 * grains.diameter;
   ds.method = scene.density_method;
@@ -111,7 +111,7 @@ nlohmann::json run_checks(const FillRecord& r, const nlohmann::json& fem) {
 }
 
 nlohmann::json report_json(const FillRecord& r, const nlohmann::json& fill, const nlohmann::json& fem) {
-  const PipelineScene& s = r.scene;
+  const scene::PipelineScene& s = r.scene;
   const mesh::PreparedDie& die = r.walls.die;
   const bool clumps = !s.shape_mesh.empty();
   const double steps = double(r.fill.loop.steps);
@@ -183,12 +183,12 @@ nlohmann::json report_json(const FillRecord& r, const nlohmann::json& fill, cons
 // Of every key that shapes the result (not where it is written, nor how fast) and the materials,
 // but the seed (run.seed beside it): runs with equal hashes are the same scene, and with equal
 // seeds too the same run (`diefill compare` tells seeds of one scene from different scenes).
-std::string scene_hash(const PipelineScene& s) {
-  PipelineScene unseeded = s;
+std::string scene_hash(const scene::PipelineScene& s) {
+  scene::PipelineScene unseeded = s;
   unseeded.seed = 0;
   std::string text;
-  for (const Shapes what : {Shapes::die, Shapes::settling, Shapes::run}) text += shaping_values(pipeline_keys(), what, unseeded);
-  return diefill::sha256_hex(text + describe_materials(s.spec));
+  for (const scene::Shapes what : {scene::Shapes::die, scene::Shapes::settling, scene::Shapes::run}) text += scene::shaping_values(scene::pipeline_keys(), what, unseeded);
+  return diefill::sha256_hex(text + scene::describe_materials(s.spec));
 }
 
 FillProducts write_fill_products(const FillSetting& setting, const Realisations& r, const fs::path& dir) {
@@ -214,4 +214,4 @@ nlohmann::json write_fill_outputs(const FillRecord& r, const fs::path& dir) {
   return report;
 }
 
-}  // namespace app
+}  // namespace pipeline

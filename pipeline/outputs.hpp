@@ -10,11 +10,11 @@
 #include "pipeline/shoe_fill.hpp"
 #include "pipeline/shoe_pass.hpp"
 
-namespace app {
+namespace pipeline {
 
 // What the outputs are made of.
 struct FillRecord {
-  const PipelineScene& scene;
+  const scene::PipelineScene& scene;
   const FillWalls& walls;
   const GrainSizing& grains;
   const ShoePlan& shoe;
@@ -37,7 +37,7 @@ struct Realisations {
 };
 // What the realisations share.
 struct FillSetting {
-  const PipelineScene& scene;
+  const scene::PipelineScene& scene;
   const FillWalls& walls;
   const GrainSizing& grains;
   const ShoePlan& shoe;
@@ -51,6 +51,6 @@ FillProducts write_fill_products(const FillSetting& setting, const Realisations&
 
 // The report's hash of the scene's shaping keys and materials, the seed left out: seeds of one
 // scene hash alike (`diefill compare`, the ensemble's check that its runs belong together).
-std::string scene_hash(const PipelineScene& scene);
+std::string scene_hash(const scene::PipelineScene& scene);
 
-}  // namespace app
+}  // namespace pipeline

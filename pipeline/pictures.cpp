@@ -7,7 +7,7 @@
 #include "core/log.hpp"
 #include "core/resources.hpp"
 
-namespace app {
+namespace pipeline {
 
 void draw_pictures(const std::vector<std::string>& arguments) {
   const std::filesystem::path script = diefill::resource_path("postprocess/plots.py");
@@ -18,4 +18,4 @@ void draw_pictures(const std::vector<std::string>& arguments) {
     diefill::log::warn("the pictures were not drawn ({} failed); install python3-matplotlib (scripts/setup.sh does)", script.string());
 }
 
-}  // namespace app
+}  // namespace pipeline

@@ -4,10 +4,10 @@
 #include <string>
 #include <vector>
 
-namespace app {
+namespace pipeline {
 
 // Runs plots.py with `arguments` (a kind of picture, then its data); warns, never fails, when
 // Python or matplotlib is missing.
 void draw_pictures(const std::vector<std::string>& arguments);
 
-}  // namespace app
+}  // namespace pipeline

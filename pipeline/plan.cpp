@@ -7,7 +7,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 
-namespace app {
+namespace pipeline {
 
 using dem::Vec3;
 
@@ -29,7 +29,7 @@ constexpr double bed_solid_fraction = 0.6;
 
 }  // namespace
 
-DieSource read_die(const PipelineScene& scene, const std::filesystem::path& die_mesh) {
+DieSource read_die(const scene::PipelineScene& scene, const std::filesystem::path& die_mesh) {
   if (mesh::parse_role(scene.die_role, "die.role") != mesh::WallRole::cavity)
     throw diefill::InputError(die_mesh.string(), "die.role", "the pipeline fills a cavity", "Give the cavity mesh (role \"cavity\")");
   DieSource die;
@@ -60,7 +60,7 @@ DieSource read_die(const PipelineScene& scene, const std::filesystem::path& die_
   return die;
 }
 
-ShoePlan plan_shoe(const PipelineScene& s, const DieSource& die) {
+ShoePlan plan_shoe(const scene::PipelineScene& s, const DieSource& die) {
   ShoePlan p;
   p.length = s.shoe_length;
   const double die_width = die.box.size().y();
@@ -83,7 +83,7 @@ ShoePlan plan_shoe(const PipelineScene& s, const DieSource& die) {
   return p;
 }
 
-GrainSizing size_grains(const PipelineScene& s, const ShoePlan& shoe, const std::string& die_name) {
+GrainSizing size_grains(const scene::PipelineScene& s, const ShoePlan& shoe, const std::string& die_name) {
   GrainSizing g;
   g.diameter = s.grain_diameter();
   const double bed = shoe.length * shoe.width * s.fill_height * bed_solid_fraction;
@@ -103,8 +103,8 @@ GrainSizing size_grains(const PipelineScene& s, const ShoePlan& shoe, const std:
   return g;
 }
 
-void set_clearance(const PipelineScene& s, const GrainSizing& grains, double table_z, ShoePlan& shoe) {
+void set_clearance(const scene::PipelineScene& s, const GrainSizing& grains, double table_z, ShoePlan& shoe) {
   shoe.motion.start_position.z() = table_z + s.clearance * grains.r_max;
 }
 
-}  // namespace app
+}  // namespace pipeline

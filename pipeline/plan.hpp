@@ -8,7 +8,7 @@
 #include "mesh/die.hpp"
 #include "scene/pipeline_scene.hpp"
 
-namespace app {
+namespace pipeline {
 
 // The die's file as read: its mesh in metres, its box and the table's height (its highest z).
 struct DieSource {
@@ -16,7 +16,7 @@ struct DieSource {
   mesh::Box box;
   double table_z = 0;
 };
-DieSource read_die(const PipelineScene& scene, const std::filesystem::path& die_mesh);
+DieSource read_die(const scene::PipelineScene& scene, const std::filesystem::path& die_mesh);
 
 // Where the shoe goes: its inner rectangle centred at (x, y_centre) on the table.
 struct ShoePlan {
@@ -40,9 +40,9 @@ struct GrainSizing {
 // has above the powder already in it, and the powder settles before the next, up to this many.
 inline constexpr int max_insertion_rounds = 4;
 
-ShoePlan plan_shoe(const PipelineScene& scene, const DieSource& die);
-GrainSizing size_grains(const PipelineScene& scene, const ShoePlan& shoe, const std::string& die_name);
+ShoePlan plan_shoe(const scene::PipelineScene& scene, const DieSource& die);
+GrainSizing size_grains(const scene::PipelineScene& scene, const ShoePlan& shoe, const std::string& die_name);
 // The shoe's start raised by the clearance under its walls, now that the grains are sized.
-void set_clearance(const PipelineScene& scene, const GrainSizing& grains, double table_z, ShoePlan& shoe);
+void set_clearance(const scene::PipelineScene& scene, const GrainSizing& grains, double table_z, ShoePlan& shoe);
 
-}  // namespace app
+}  // namespace pipeline

@@ -7,15 +7,16 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "dem/state.hpp"
 
-namespace app {
+namespace pipeline {
 
 namespace {
 
 // Two grains, the smallest and the largest the size distribution draws: the model's time step is
 // the smallest Rayleigh and collision time over its grains, and its skin follows the largest.
 dem::Model compile_on_stand_ins(const dem::ModelSpec& spec, double diameter, double spread, const std::string& source) {
-  const int powder = material_named(spec, "powder");
+  const int powder = scene::material_named(spec, "powder");
   dem::State stand_ins;
   const double density = spec.materials[std::size_t(powder)].density;
   stand_ins.add_sphere(0, dem::Vec3::Zero(), 0.5 * diameter * (1 - spread), density, powder);
@@ -27,8 +28,8 @@ std::size_t steps_of(double duration, double dt) { return std::size_t(std::llrou
 
 }  // namespace
 
-dem::ModelSpec fill_laws(const PipelineScene& s, const GrainSizing& grains, double die_depth) {
-  dem::ModelSpec spec = coarse_grained_spec(s.spec, grains.alpha);
+dem::ModelSpec fill_laws(const scene::PipelineScene& s, const GrainSizing& grains, double die_depth) {
+  dem::ModelSpec spec = scene::coarse_grained_spec(s.spec, grains.alpha);
   spec.max_impact_speed = std::max(spec.max_impact_speed, std::sqrt(2 * spec.gravity.norm() * die_depth) + s.speed);
   return spec;
 }
@@ -37,7 +38,7 @@ namespace {
 
 // The grids the outputs bin on, each refused (InputError naming its key) when it would hold more
 // voxels than the limit: the density field, the smoothed field, the FEM hand-off's sub-voxels.
-void check_grids(const PipelineScene& s, const DieSource& die, const GrainSizing& grains) {
+void check_grids(const scene::PipelineScene& s, const DieSource& die, const GrainSizing& grains) {
   const double density_voxel = s.density_voxel > 0 ? s.density_voxel : 2 * grains.diameter;
   const double element = s.fem_element_size > 0 ? s.fem_element_size : density_voxel;
   const struct {
@@ -65,12 +66,12 @@ void check_grids(const PipelineScene& s, const DieSource& die, const GrainSizing
 
 }  // namespace
 
-RunSize preflight(const PipelineScene& s, const DieSource& die, const ShoePlan& shoe, const GrainSizing& grains) {
+RunSize preflight(const scene::PipelineScene& s, const DieSource& die, const ShoePlan& shoe, const GrainSizing& grains) {
   check_grids(s, die, grains);
   RunSize size;
   size.grains = grains.count;
   // The settling sees the scene's impact speed; the pass the raised one and the shoe's motion.
-  const dem::Model settling = compile_on_stand_ins(coarse_grained_spec(s.spec, grains.alpha), grains.diameter, s.diameter_spread, s.source);
+  const dem::Model settling = compile_on_stand_ins(scene::coarse_grained_spec(s.spec, grains.alpha), grains.diameter, s.diameter_spread, s.source);
   const dem::ModelSpec pass_laws = fill_laws(s, grains, die.box.size().z());
   if (pass_laws.max_impact_speed > s.spec.max_impact_speed)
     diefill::log::info("{}: impacts reach {:.3g} m/s in this die; time step set for them (simulation.max_impact_speed is {:.3g})",
@@ -86,11 +87,11 @@ RunSize preflight(const PipelineScene& s, const DieSource& die, const ShoePlan& 
   return size;
 }
 
-void preflight_laws(const PipelineScene& s) {
-  compile_on_stand_ins(coarse_grained_spec(s.spec, s.coarse_graining), s.grain_diameter(), s.diameter_spread, s.source);
+void preflight_laws(const scene::PipelineScene& s) {
+  compile_on_stand_ins(scene::coarse_grained_spec(s.spec, s.coarse_graining), s.grain_diameter(), s.diameter_spread, s.source);
 }
 
-void refuse_oversized(const PipelineScene& s, const RunSize& size, const std::string& source) {
+void refuse_oversized(const scene::PipelineScene& s, const RunSize& size, const std::string& source) {
   if (size.particle_steps <= particle_step_limit || s.force) return;
   throw diefill::InputError(
       source, "run size",
@@ -111,4 +112,4 @@ std::string describe_size(const RunSize& size, const std::string& die_name) {
       size.particle_steps, particle_step_limit);
 }
 
-}  // namespace app
+}  // namespace pipeline

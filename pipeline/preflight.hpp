@@ -8,11 +8,11 @@
 #include "dem/model.hpp"
 #include "pipeline/plan.hpp"
 
-namespace app {
+namespace pipeline {
 
 // The fill's coarse-grained laws, their impact speed raised to that of a grain falling the die's
 // depth plus the shoe's speed: the collision time must resolve the fastest impact.
-dem::ModelSpec fill_laws(const PipelineScene& scene, const GrainSizing& grains, double die_depth);
+dem::ModelSpec fill_laws(const scene::PipelineScene& scene, const GrainSizing& grains, double die_depth);
 
 struct RunSize {
   std::size_t grains = 0;                // that fill the shoe (clumps: times their spheres in the DEM)
@@ -31,12 +31,12 @@ inline constexpr double voxel_limit = 2e8;
 // Compiles the settling's and the pass's models on stand-in grains (the smallest and the
 // largest), so that every check the run's compilation makes, the shoe's travel per step
 // included, refuses the scene now (InputError), and returns the run's size.
-RunSize preflight(const PipelineScene& scene, const DieSource& die, const ShoePlan& shoe, const GrainSizing& grains);
+RunSize preflight(const scene::PipelineScene& scene, const DieSource& die, const ShoePlan& shoe, const GrainSizing& grains);
 // The same checks for a scene without a die: the laws on the scene's own grains.
-void preflight_laws(const PipelineScene& scene);
+void preflight_laws(const scene::PipelineScene& scene);
 // InputError naming `source` when the size exceeds the limit and the scene is not forced.
-void refuse_oversized(const PipelineScene& scene, const RunSize& size, const std::string& source);
+void refuse_oversized(const scene::PipelineScene& scene, const RunSize& size, const std::string& source);
 // The size as TOML comment lines, for `diefill scene`.
 std::string describe_size(const RunSize& size, const std::string& die_name);
 
-}  // namespace app
+}  // namespace pipeline

@@ -1,6 +1,7 @@
 #include "pipeline/run_loop.hpp"
 
 #include <fmt/core.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <atomic>
@@ -8,10 +9,11 @@
 #include <csignal>
 
 #include "core/error.hpp"
+#include "core/log.hpp"
 #include "core/progress.hpp"
 #include "dem/checkpoint.hpp"
 
-namespace app {
+namespace pipeline {
 
 namespace {
 std::atomic<bool> g_interrupted{false};
@@ -39,11 +41,31 @@ void track_checks(dem::State& s) {
 }
 }  // namespace
 
+ThreadCount::ThreadCount(int threads) : saved_(omp_get_max_threads()) {
+  if (threads > 0) omp_set_num_threads(threads);
+}
+ThreadCount::~ThreadCount() { omp_set_num_threads(saved_); }
+
 void install_interrupt_handler() {
   for (int signal : stop_signals) std::signal(signal, on_interrupt);
 }
 
 bool stop_requested() { return g_interrupted; }
+
+bool start_or_resume(const dem::Model& model, dem::State& state, const std::filesystem::path& checkpoint, bool resume,
+                     const std::string& name, const std::function<void()>& before_reading) {
+  const bool found = state.exchange ? state.exchange->max(state.exchange->rank() == 0 && std::filesystem::exists(checkpoint) ? 1.0 : 0.0) > 0
+                                    : std::filesystem::exists(checkpoint);
+  if (resume && found) {
+    if (before_reading) before_reading();
+    state = dem::read_checkpoint(model, checkpoint, state.exchange);
+    diefill::log::info("{}: resumed at t = {:.6g} s", name, state.time);
+    return true;
+  }
+  if (resume) diefill::log::warn("{}: --resume: no checkpoint at {}; the run starts afresh", name, checkpoint.string());
+  dem::initialize(model, state);
+  return false;
+}
 
 std::int64_t first_output_after_resume(double origin, double every, double time, double dt) {
   // Due by time - dt with the loop's half-step margin: origin + n·every - dt/2 <= time - dt.
@@ -108,4 +130,4 @@ nlohmann::json stage_times_json(const dem::StageTimes& t) {
           {"wall_forces", t.wall_forces}, {"integration", t.integration}, {"monitor", t.monitor}};
 }
 
-}  // namespace app
+}  // namespace pipeline

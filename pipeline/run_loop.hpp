@@ -13,7 +13,7 @@
 #include "dem/state.hpp"
 #include "dem/step.hpp"
 
-namespace app {
+namespace pipeline {
 
 // An output at its own cadence: at the start, every `every` seconds of simulated time, and at the end.
 // Output n falls due at the loop's output origin + n·every and is written at the first step that
@@ -60,6 +60,20 @@ struct LoopResult {
   double max_energy_gain = 0;  // 0 when the energy never exceeded its budget
 };
 
+// The thread count of a run, a study or a calibration for its duration (0: leave it), restored
+// afterwards so that a process running several dies or studies keeps its own setting: the one
+// place a command's --threads (or the scene's threads) takes effect.
+class ThreadCount {
+ public:
+  explicit ThreadCount(int threads);
+  ~ThreadCount();
+  ThreadCount(const ThreadCount&) = delete;
+  ThreadCount& operator=(const ThreadCount&) = delete;
+
+ private:
+  int saved_;
+};
+
 // Installs the handler of Ctrl-C, SIGTERM and SIGUSR1 (once); a second signal kills the process as usual.
 void install_interrupt_handler();
 // Whether one of them arrived: the stages after the DEM loop stop their long steps on it.
@@ -67,7 +81,15 @@ bool stop_requested();
 
 LoopResult run_until(const dem::Model& model, dem::State& state, const LoopOptions& options);
 
+// Where a stepped run starts: from its checkpoint when asked to resume and one is there, else
+// afresh (the state initialised; a resume without a checkpoint is said, as a warning). Split over
+// ranks, every rank goes by what rank 0 finds. `before_reading` runs before the checkpoint replaces
+// the state (a run's own outputs so far are read while the state still has its starting time).
+// Returns whether the run resumed: LoopOptions::resumed.
+bool start_or_resume(const dem::Model& model, dem::State& state, const std::filesystem::path& checkpoint, bool resume,
+                     const std::string& name, const std::function<void()>& before_reading = {});
+
 // Seconds per stage, as the reports write them.
 nlohmann::json stage_times_json(const dem::StageTimes& times);
 
-}  // namespace app
+}  // namespace pipeline

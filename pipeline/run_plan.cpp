@@ -15,7 +15,7 @@
 #include "pipeline/extrapolate.hpp"
 #include "pipeline/throughput.hpp"
 
-namespace app {
+namespace pipeline {
 
 namespace fs = std::filesystem;
 
@@ -67,13 +67,13 @@ double ladder_stderr(const std::vector<const PlanLevel*>& levels, int seeds, dou
 // One size's run; with N seeds on voxels finer by N^(1/3): one run's noise per voxel falls as
 // 1/√(grains per voxel), so N seeds on voxels of 2d/N^(1/3) are as noisy as one on 2d (the
 // default), and resolve features N^(1/3) times finer; the elements stay at 2d.
-std::string single_command(const PipelineScene& s, double alpha, double diameter, int seeds) {
+std::string single_command(const scene::PipelineScene& s, double alpha, double diameter, int seeds) {
   if (seeds == 1) return fmt::format("diefill run {} --set powder.coarse_graining={}", s.die.string(), alpha);
   return fmt::format("diefill run {} --set powder.coarse_graining={} --seeds {} --set density.voxel={:.3g} --set fem.element_size={:.3g}",
                      s.die.string(), alpha, seeds, 2 * diameter / std::cbrt(double(seeds)), 2 * diameter);
 }
 
-std::vector<PlanOption> options_of(const PipelineScene& s, const std::vector<PlanLevel>& levels, const PlanRequest& r) {
+std::vector<PlanOption> options_of(const scene::PipelineScene& s, const std::vector<PlanLevel>& levels, const PlanRequest& r) {
   std::vector<PlanOption> out;
   const double a = r.accuracy, target = s.particle_diameter;
   for (const PlanLevel& l : levels) {
@@ -117,7 +117,7 @@ std::optional<std::size_t> choose(const std::vector<PlanOption>& options) {
 
 }  // namespace
 
-Plan make_plan(const PipelineScene& scene, const PlanRequest& request) {
+Plan make_plan(const scene::PipelineScene& scene, const PlanRequest& request) {
   if (!(request.accuracy > 0 && request.accuracy < 0.5))
     throw diefill::InputError("--accuracy", fmt::format("{}", request.accuracy), "is no standard error of a fill ratio",
                               "Give one in (0, 0.5), e.g. 0.01");
@@ -137,7 +137,7 @@ Plan make_plan(const PipelineScene& scene, const PlanRequest& request) {
   plan.timed_runs = model.runs;
   plan.machine = machine_key(scene.threads > 0 ? scene.threads : omp_get_max_threads());
   for (const double alpha : alpha_grid()) {
-    PipelineScene s = scene;
+    scene::PipelineScene s = scene;
     s.coarse_graining = alpha;
     s.max_grains = std::numeric_limits<std::size_t>::max() / 2;  // the plan sees the grains a size needs
     PlanLevel l;
@@ -228,4 +228,4 @@ double parse_duration(const std::string& text) {
   return total;
 }
 
-}  // namespace app
+}  // namespace pipeline

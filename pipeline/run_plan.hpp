@@ -13,7 +13,7 @@
 #include "pipeline/preflight.hpp"
 #include "scene/pipeline_scene.hpp"
 
-namespace app {
+namespace pipeline {
 
 struct PlanRequest {
   double accuracy = 0.01;  // the standard error of the fill ratio asked for
@@ -57,11 +57,11 @@ struct Plan {
 };
 
 // Plans the scene's die (refused as `diefill run` would refuse it).
-Plan make_plan(const PipelineScene& scene, const PlanRequest& request);
+Plan make_plan(const scene::PipelineScene& scene, const PlanRequest& request);
 nlohmann::json plan_json(const Plan& plan);
 std::string plan_table(const Plan& plan);
 
 // "90", "90s", "30m", "2h", "1h30m": seconds; InputError naming --budget otherwise.
 double parse_duration(const std::string& text);
 
-}  // namespace app
+}  // namespace pipeline

@@ -16,9 +16,10 @@
 #include "dem/step.hpp"
 #include "pipeline/clump_stage.hpp"
 #include "pipeline/run_loop.hpp"
+#include "pipeline/shoe_source_hash.hpp"
 #include "scene/physics_keys.hpp"
 
-namespace app {
+namespace pipeline {
 
 namespace fs = std::filesystem;
 using dem::Vec3;
@@ -28,7 +29,7 @@ namespace {
 constexpr double insertion_solid_fraction = 0.45;  // stop a round's insertion at this fill of its box
 
 struct Insertion {
-  const PipelineScene& scene;
+  const scene::PipelineScene& scene;
   const FillWalls& walls;
   const GrainSizing& grains;
   const ShoePlan& shoe;
@@ -158,16 +159,19 @@ void expect_same_template_on_every_rank(const mesh::ClumpTemplate& clump, dem::E
 
 }  // namespace
 
-std::string settled_shoe_key(const PipelineScene& s, const SettledShoeInputs& in, std::string_view dem_source_hash) {
-  // A smoke run's shoe (PipelineScene::max_steps) is not settled: it is never a real run's.
-  return diefill::sha256_hex(fmt::format("settled shoe v3;{};{};{}{};{:a};{:a};{};{:a};{:a};{:a};{:a};{:a};{};{}", dem_source_hash,
-                                         in.die_cache_key, shaping_values(pipeline_keys(), Shapes::settling, s),
-                                         describe_materials(s.spec), in.grains.diameter, in.grains.r_max, in.grains.count,
+std::string settled_shoe_key(const scene::PipelineScene& s, const SettledShoeInputs& in, std::string_view dem_source_hash) {
+  // What makes a shoe: the code (this file's and the DEM's sources), the die, the settling keys,
+  // the materials, the grains and the shoe. A smoke run's shoe (PipelineScene::max_steps) is not
+  // settled: it is never a real run's.
+  return diefill::sha256_hex(fmt::format("settled shoe;{};{};{};{}{};{:a};{:a};{};{:a};{:a};{:a};{:a};{:a};{};{}",
+                                         DIEFILL_SHOE_SOURCE_HASH, dem_source_hash, in.die_cache_key,
+                                         scene::shaping_values(scene::pipeline_keys(), scene::Shapes::settling, s),
+                                         scene::describe_materials(s.spec), in.grains.diameter, in.grains.r_max, in.grains.count,
                                          in.shoe.length, in.shoe.width, in.shoe.x_start, in.shoe.y_centre, in.table_z, in.powder,
                                          s.max_steps));
 }
 
-std::optional<SettledShoe> fill_and_settle_shoe(const PipelineScene& s, const FillWalls& walls, const GrainSizing& grains,
+std::optional<SettledShoe> fill_and_settle_shoe(const scene::PipelineScene& s, const FillWalls& walls, const GrainSizing& grains,
                                                 const ShoePlan& shoe, double table_z, const std::shared_ptr<dem::Exchange>& ranks) {
   Insertion in{s, walls, grains, shoe, table_z, std::nullopt, ranks};
   // Clumps are settled afresh each run: the particles file does not hold their poses.
@@ -203,4 +207,4 @@ std::optional<SettledShoe> fill_and_settle_shoe(const PipelineScene& s, const Fi
   return out;
 }
 
-}  // namespace app
+}  // namespace pipeline

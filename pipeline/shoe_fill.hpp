@@ -9,7 +9,7 @@
 #include "dem/state.hpp"
 #include "pipeline/walls.hpp"
 
-namespace app {
+namespace pipeline {
 
 // What the cached settled shoe depends on besides the scene's settling keys (scene_keys.hpp).
 struct SettledShoeInputs {
@@ -21,7 +21,7 @@ struct SettledShoeInputs {
 };
 // The cache key: the settling keys' values, the materials, the derived geometry and the DEM's
 // source hash (changed contact code never reuses a shoe settled by the old code).
-std::string settled_shoe_key(const PipelineScene& scene, const SettledShoeInputs& inputs, std::string_view dem_source_hash);
+std::string settled_shoe_key(const scene::PipelineScene& scene, const SettledShoeInputs& inputs, std::string_view dem_source_hash);
 
 struct SettledShoe {
   dem::State state;            // at rest, time 0 (this rank's share of it, split over ranks)
@@ -32,7 +32,7 @@ struct SettledShoe {
 };
 // nullopt when Ctrl-C stopped the settling (nothing is cached then). Split over ranks (non-null
 // `ranks`), the grains are settled split, and the state returned is this rank's share.
-std::optional<SettledShoe> fill_and_settle_shoe(const PipelineScene& scene, const FillWalls& walls, const GrainSizing& grains,
+std::optional<SettledShoe> fill_and_settle_shoe(const scene::PipelineScene& scene, const FillWalls& walls, const GrainSizing& grains,
                                                 const ShoePlan& shoe, double table_z, const std::shared_ptr<dem::Exchange>& ranks);
 
-}  // namespace app
+}  // namespace pipeline

@@ -14,7 +14,7 @@
 #include "dem/step.hpp"
 #include "mesh/import.hpp"
 
-namespace app {
+namespace pipeline {
 
 namespace fs = std::filesystem;
 
@@ -90,7 +90,7 @@ OutputsSoFar load_outputs(const fs::path& checkpoint, double origin, std::uint64
 
 }  // namespace
 
-std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& walls, const ShoePlan& shoe, double table_z,
+std::optional<FillResult> move_shoe(const scene::PipelineScene& s, const FillWalls& walls, const ShoePlan& shoe, double table_z,
                                     dem::State settled, const fs::path& dir, bool resume) {
   dem::ModelSpec spec = walls.spec;
   spec.meshes[1].motion = shoe.motion;
@@ -99,18 +99,9 @@ std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& wal
   const dem::Model model = dem::compile_model(spec, state, s.source);
   fill.dt = model.dt;
   const fs::path checkpoint = dir / "checkpoint.bin";
-  // Split over ranks, rank 0 looks for the checkpoint and every rank goes by what it saw.
-  const bool found = state.exchange ? state.exchange->max(state.exchange->rank() == 0 && fs::exists(checkpoint) ? 1.0 : 0.0) > 0
-                                    : fs::exists(checkpoint);
   OutputsSoFar so_far{state.time, {}, {}};
-  if (resume && found) {
-    so_far = load_outputs(checkpoint, state.time, s.seed);
-    state = dem::read_checkpoint(model, checkpoint, state.exchange);
-    diefill::log::info("{}: resumed at t = {:.6g} s", walls.die.name, state.time);
-  } else {
-    if (resume) diefill::log::warn("{}: --resume: no checkpoint in {}; the fill starts afresh", walls.die.name, dir.string());
-    dem::initialize(model, state);
-  }
+  const bool resumed = start_or_resume(model, state, checkpoint, resume, walls.die.name,
+                                       [&] { so_far = load_outputs(checkpoint, state.time, s.seed); });
   fill.curve = std::move(so_far.curve);
   std::vector<double>& snapshot_times = so_far.snapshot_times;
   const mesh::TriMesh shoe_surface = surface_of(*walls.shoe_field);
@@ -119,7 +110,7 @@ std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& wal
   loop.max_steps = s.max_steps;
   loop.label = walls.die.name + ": filling";
   loop.checkpoint = checkpoint;
-  loop.resumed = resume && found;
+  loop.resumed = resumed;
   loop.output_origin = so_far.origin;
   if (s.snapshot_every > 0)
     loop.outputs.push_back({s.snapshot_every, [&](const dem::State& st) {
@@ -158,4 +149,4 @@ std::optional<FillResult> move_shoe(const PipelineScene& s, const FillWalls& wal
   return fill;
 }
 
-}  // namespace app
+}  // namespace pipeline

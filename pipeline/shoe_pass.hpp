@@ -9,7 +9,7 @@
 #include "pipeline/run_loop.hpp"
 #include "pipeline/walls.hpp"
 
-namespace app {
+namespace pipeline {
 
 struct FillResult {
   dem::State state;  // split over ranks: the whole state on rank 0, none elsewhere
@@ -20,7 +20,7 @@ struct FillResult {
 
 // nullopt when Ctrl-C stopped it (a checkpoint is in `dir`); StabilityError when a check did.
 // `settled` is this rank's share when the run is split over ranks (its exchange).
-std::optional<FillResult> move_shoe(const PipelineScene& scene, const FillWalls& walls, const ShoePlan& shoe, double table_z,
+std::optional<FillResult> move_shoe(const scene::PipelineScene& scene, const FillWalls& walls, const ShoePlan& shoe, double table_z,
                                     dem::State settled, const std::filesystem::path& dir, bool resume);
 
-}  // namespace app
+}  // namespace pipeline

@@ -9,7 +9,7 @@
 #include "dem/distributed.hpp"
 #include "pipeline/pictures.hpp"
 
-namespace app {
+namespace pipeline {
 
 namespace fs = std::filesystem;
 
@@ -28,12 +28,12 @@ Sweep parse_sweep(const std::string& text) {
   return s;
 }
 
-std::vector<DieRun> run_sweep(const std::function<PipelineScene(const std::vector<std::string>& overrides)>& load,
+std::vector<DieRun> run_sweep(const std::function<scene::PipelineScene(const std::vector<std::string>& overrides)>& load,
                               const Sweep& sweep, const std::shared_ptr<dem::Exchange>& ranks) {
   if (sweep.key.starts_with("output."))
     throw diefill::InputError("--sweep", sweep.key, "says where outputs go, not what is simulated", "Sweep a key that shapes the fill");
   // Every case's scene first: a bad value is refused before any run.
-  std::vector<PipelineScene> scenes;
+  std::vector<scene::PipelineScene> scenes;
   for (const std::string& value : sweep.values) {
     if (value.find('/') != std::string::npos)
       throw diefill::InputError("--sweep", sweep.key, "value '" + value + "' would name a folder inside another", "Give plain values");
@@ -42,7 +42,7 @@ std::vector<DieRun> run_sweep(const std::function<PipelineScene(const std::vecto
   const fs::path base = scenes.front().out;
   std::vector<DieRun> runs;
   for (std::size_t k = 0; k < scenes.size(); ++k) {
-    PipelineScene& scene = scenes[k];
+    scene::PipelineScene& scene = scenes[k];
     if (scene.cache.empty()) scene.cache = base / ".cache";  // one settled shoe for every case it fits
     scene.out = base / (sweep.key + "=" + sweep.values[k]);
     // Rank 0 writes the outputs after the others have finished the case: should that fail, every
@@ -72,4 +72,4 @@ std::vector<DieRun> run_sweep(const std::function<PipelineScene(const std::vecto
   return runs;
 }
 
-}  // namespace app
+}  // namespace pipeline

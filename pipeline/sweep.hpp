@@ -10,7 +10,7 @@
 #include "dem/exchange.hpp"
 #include "pipeline/die_fill.hpp"
 
-namespace app {
+namespace pipeline {
 
 struct Sweep {
   std::string key;                  // a scene key, as --set names it: motion.speed
@@ -26,7 +26,7 @@ Sweep parse_sweep(const std::string& text);
 // ratio, mass and grains against the value. Every case's scene is loaded (and a bad value
 // refused) before the first run; output.* keys are refused. Returns the runs (empty reports
 // off rank 0).
-std::vector<DieRun> run_sweep(const std::function<PipelineScene(const std::vector<std::string>& overrides)>& load,
+std::vector<DieRun> run_sweep(const std::function<scene::PipelineScene(const std::vector<std::string>& overrides)>& load,
                               const Sweep& sweep, const std::shared_ptr<dem::Exchange>& ranks);
 
-}  // namespace app
+}  // namespace pipeline

@@ -13,8 +13,9 @@
 #include "dem/insert.hpp"
 #include "dem/model.hpp"
 #include "dem/step.hpp"
+#include "pipeline/run_loop.hpp"
 
-namespace app {
+namespace pipeline {
 
 namespace fs = std::filesystem;
 
@@ -27,7 +28,7 @@ std::string processor_name() {
   return "unknown processor";
 }
 
-int threads_of(const PipelineScene& s) { return s.threads > 0 ? s.threads : omp_get_max_threads(); }
+int threads_of(const scene::PipelineScene& s) { return s.threads > 0 ? s.threads : omp_get_max_threads(); }
 
 nlohmann::json read_json(const fs::path& file) {
   std::ifstream in(file);
@@ -42,9 +43,9 @@ nlohmann::json read_json(const fs::path& file) {
 // 4,000 of the scene's grains in a box of planes 20 grains wide, inserted as densely as random
 // insertion goes (a bed of grains in contact, as a fill's mostly is): 100 steps to start, then
 // the particle-steps per second of 300.
-double measure_kernel(const PipelineScene& s, const GrainSizing& grains) {
-  dem::ModelSpec spec = coarse_grained_spec(s.spec, grains.alpha);
-  const int powder = material_named(spec, "powder"), steel = material_named(spec, "steel");
+double measure_kernel(const scene::PipelineScene& s, const GrainSizing& grains) {
+  dem::ModelSpec spec = scene::coarse_grained_spec(s.spec, grains.alpha);
+  const int powder = scene::material_named(spec, "powder"), steel = scene::material_named(spec, "steel");
   const double d = grains.diameter, half = 10 * d;
   spec.planes = {{dem::Vec3::Zero(), dem::Vec3::UnitZ(), steel, "floor"},
                  {dem::Vec3(-half, 0, 0), dem::Vec3::UnitX(), steel, "x-"}, {dem::Vec3(half, 0, 0), -dem::Vec3::UnitX(), steel, "x+"},
@@ -76,15 +77,15 @@ std::string machine_key(int threads) {
                      dem::source_hash());
 }
 
-double kernel_rate(const PipelineScene& s, const GrainSizing& grains, const fs::path& cache) {
+double kernel_rate(const scene::PipelineScene& s, const GrainSizing& grains, const fs::path& cache) {
   const fs::path file = cache / "throughput.json";
   nlohmann::json rates = read_json(file);
   const std::string key = machine_key(threads_of(s));
   if (rates.contains(key)) return rates[key].get<double>();
-  const int saved = omp_get_max_threads();
-  omp_set_num_threads(threads_of(s));
-  const double rate = measure_kernel(s, grains);
-  omp_set_num_threads(saved);
+  const double rate = [&] {
+    const ThreadCount threads(threads_of(s));
+    return measure_kernel(s, grains);
+  }();
   rates[key] = rate;
   fs::create_directories(cache);
   diefill::write_file_atomic(file, rates.dump(2) + "\n");
@@ -124,4 +125,4 @@ void record_timing(const fs::path& cache, double particle_steps, double wall_s, 
   out << line.dump() << "\n";
 }
 
-}  // namespace app
+}  // namespace pipeline

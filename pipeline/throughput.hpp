@@ -8,11 +8,11 @@
 
 #include "pipeline/plan.hpp"
 
-namespace app {
+namespace pipeline {
 
 // The kernel's particle-steps per second at the scene's thread count, from `cache` when measured
 // before on this machine (its processor, thread count and the DEM's source hash).
-double kernel_rate(const PipelineScene& scene, const GrainSizing& grains, const std::filesystem::path& cache);
+double kernel_rate(const scene::PipelineScene& scene, const GrainSizing& grains, const std::filesystem::path& cache);
 
 // The defaults: fitted to six runs from fresh shoes on the development machine (ring and disc at
 // α = 16, 11.3 and 8, two threads, 2026-12-06: 18-223 s, each within 18 % of the fit).
@@ -35,4 +35,4 @@ void record_timing(const std::filesystem::path& cache, double particle_steps, do
 // hardware threads, the threads asked for and the DEM's source hash.
 std::string machine_key(int threads);
 
-}  // namespace app
+}  // namespace pipeline

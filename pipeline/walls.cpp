@@ -11,7 +11,7 @@
 #include "mesh/shapes.hpp"
 #include "pipeline/preflight.hpp"
 
-namespace app {
+namespace pipeline {
 
 using dem::Vec3;
 
@@ -19,7 +19,7 @@ namespace {
 
 // The die's mesh stage for grains of largest radius r: voxels a fraction of it, the table as long
 // as the shoe's travel and as wide as the shoe, plus a margin.
-mesh::DieOptions die_options(const PipelineScene& s, const GrainSizing& grains, const ShoePlan& shoe, const DieSource& source) {
+mesh::DieOptions die_options(const scene::PipelineScene& s, const GrainSizing& grains, const ShoePlan& shoe, const DieSource& source) {
   const double r = grains.r_max;
   mesh::DieOptions o = mesh::die_options_for_grains(r, 0.5 * r, s.die_voxel_fraction * r);
   o.unit = source.file.unit;
@@ -38,7 +38,7 @@ mesh::DieOptions die_options(const PipelineScene& s, const GrainSizing& grains, 
 // A shoe from a mesh is a tool in its own frame (origin at the inner centre, on the table); the
 // built-in one a rectangular tube. Voxels as mesh::contact_wall_field's: the query is exact, the
 // voxels only find candidates.
-std::shared_ptr<const mesh::WallField> shoe_field(const PipelineScene& s, const GrainSizing& grains, const ShoePlan& shoe,
+std::shared_ptr<const mesh::WallField> shoe_field(const scene::PipelineScene& s, const GrainSizing& grains, const ShoePlan& shoe,
                                                   mesh::LengthUnit unit, const std::filesystem::path& cache) {
   const double r = grains.r_max;
   if (s.shoe_mesh.empty())
@@ -69,7 +69,7 @@ void check_grains_enter(const FillWalls& w, const DieSource& source, const Grain
 }
 
 // The coarse-grained laws with the die and the shoe as walls, inside the table's extent.
-dem::ModelSpec fill_spec(const PipelineScene& s, const FillWalls& w, const DieSource& source, const GrainSizing& grains,
+dem::ModelSpec fill_spec(const scene::PipelineScene& s, const FillWalls& w, const DieSource& source, const GrainSizing& grains,
                          const ShoePlan& shoe, const mesh::TableExtent& table) {
   dem::ModelSpec spec = fill_laws(s, grains, source.box.size().z());
   spec.domain = {Vec3(table.x_min, table.y_min, source.box.lo.z() - 1e-3),
@@ -110,10 +110,10 @@ double largest_inscribed_radius_bound(const mesh::WallField& die, const mesh::Tr
   return best + 0.5 * std::sqrt(3.0) * spacing;
 }
 
-FillWalls prepare_walls(const PipelineScene& s, const DieSource& source, const GrainSizing& grains, const ShoePlan& shoe) {
+FillWalls prepare_walls(const scene::PipelineScene& s, const DieSource& source, const GrainSizing& grains, const ShoePlan& shoe) {
   FillWalls w;
-  w.powder = material_named(s.spec, "powder");
-  w.steel = material_named(s.spec, "steel");
+  w.powder = scene::material_named(s.spec, "powder");
+  w.steel = scene::material_named(s.spec, "steel");
   w.cache = s.cache.empty() ? s.out / ".cache" : s.cache;
   const mesh::DieOptions options = die_options(s, grains, shoe, source);
   w.die = mesh::prepare_die(source.file, options, w.cache);
@@ -125,4 +125,4 @@ FillWalls prepare_walls(const PipelineScene& s, const DieSource& source, const G
   return w;
 }
 
-}  // namespace app
+}  // namespace pipeline

@@ -8,7 +8,7 @@
 #include "dem/model.hpp"
 #include "pipeline/plan.hpp"
 
-namespace app {
+namespace pipeline {
 
 struct FillWalls {
   mesh::PreparedDie die;
@@ -19,10 +19,10 @@ struct FillWalls {
 };
 
 // Throws InputError when the die cannot be repaired or the grains cannot enter its cavity.
-FillWalls prepare_walls(const PipelineScene& scene, const DieSource& source, const GrainSizing& grains, const ShoePlan& shoe);
+FillWalls prepare_walls(const scene::PipelineScene& scene, const DieSource& source, const GrainSizing& grains, const ShoePlan& shoe);
 
 // Upper bound of the radius of the largest sphere the cavity holds below the table.
 double largest_inscribed_radius_bound(const mesh::WallField& die, const mesh::TriMesh& die_solid, const mesh::Box& cavity,
                                       double table_z, double spacing);
 
-}  // namespace app
+}  // namespace pipeline

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <set>
 
-namespace app {
+namespace scene {
 
 namespace {
 
@@ -106,4 +106,4 @@ std::string describe_materials(const dem::ModelSpec& spec) {
   return out;
 }
 
-}  // namespace app
+}  // namespace scene

@@ -3,6 +3,7 @@
 // entries of [[materials]] and [[interactions]] (docs/PHYSICS.md §2 for the laws, §5 for the time
 // step), with their ranges.
 #include <cmath>
+#include <deque>
 #include <limits>
 #include <optional>
 #include <string>
@@ -12,7 +13,7 @@
 #include "dem/model.hpp"
 #include "scene/scene_keys.hpp"
 
-namespace app {
+namespace scene {
 
 // The entries of [[materials]].
 const KeyTable<dem::Material>& material_keys();
@@ -30,23 +31,24 @@ const KeyTable<InteractionEntry>& interaction_keys();
 template <class Target>
 void add_physics_keys(KeyTable<Target>& keys, dem::ModelSpec& (*spec)(Target&), Shapes shapes) {
   const auto of = [spec](const Target& t) -> const dem::ModelSpec& { return spec(const_cast<Target&>(t)); };
-  const auto law = [&](std::string_view name, std::vector<std::string_view> choices, std::string_view meaning, auto member) {
-    keys.push_back({"contact", name, KeyType::choice, "", {}, choices, shapes, meaning,
-                    [of, member, choices](const Target& t) -> KeyValue { return std::string(choices[std::size_t(of(t).*member)]); },
-                    [spec, member, choices](Target& t, const KeyValue& v) {
-                      using Law = std::remove_cvref_t<decltype(spec(t).*member)>;
-                      const auto at = std::find(choices.begin(), choices.end(), std::get<std::string>(v));
-                      spec(t).*member = Law(at - choices.begin());
-                    }});
+  // One key per slot, its choices the laws the registry holds (dem/contact_laws.hpp), its meaning
+  // theirs; kept as long as the key tables, which live for the program.
+  static std::deque<std::string> law_meanings;
+  const auto law = [&](dem::LawSlot slot, std::string_view what) {
+    const std::vector<std::string_view> choices = dem::slot_law_names(slot);
+    std::string& meaning = law_meanings.emplace_back(what);
+    for (const dem::SlotLaw& l : dem::slot_laws())
+      if (l.slot == slot)
+        meaning.append(meaning.back() == ':' ? " " : "; ").append(l.name).append(": ").append(l.meaning)
+            .append(l.reads.empty() ? "" : " (reads ").append(l.reads).append(l.reads.empty() ? "" : ")");
+    keys.push_back({"contact", dem::law_slot_names[std::size_t(slot)], KeyType::choice, "", {}, choices, shapes, meaning,
+                    [of, slot](const Target& t) -> KeyValue { return of(t).law[slot]; },
+                    [spec, slot](Target& t, const KeyValue& v) { spec(t).law[slot] = std::get<std::string>(v); }});
   };
-  law("normal", {"hertz", "linear"}, "normal force: Hertz, or a linear spring (contact.linear_stiffness)", &dem::ModelSpec::normal);
-  law("tangential", {"mindlin", "none"}, "tangential spring with a Coulomb cap (Mindlin), or frictionless",
-      &dem::ModelSpec::tangential);
-  law("rolling", {"epsd", "cdt", "none"},
-      "rolling resistance: elastic-plastic spring, constant directional torque, or none (spheres need it for 30-40° repose)",
-      &dem::ModelSpec::rolling);
-  law("cohesion", {"sjkr", "none"}, "simplified JKR cohesion (materials' cohesion_energy_density), or none",
-      &dem::ModelSpec::cohesion);
+  law(dem::LawSlot::normal, "the normal force:");
+  law(dem::LawSlot::tangential, "the tangential force:");
+  law(dem::LawSlot::rolling, "rolling resistance:");
+  law(dem::LawSlot::cohesion, "cohesion:");
   const auto number = [&](std::string_view table, std::string_view name, KeyType type, std::string_view unit, ValueRange range,
                           std::string_view meaning, auto get, auto set) {
     keys.push_back({table, name, type, unit, range, {}, shapes, meaning,
@@ -95,4 +97,4 @@ std::vector<std::string> read_materials(Table& root, dem::ModelSpec& spec, const
 // The [[materials]] and [[interactions]] of a spec as TOML, each value with its meaning.
 std::string describe_materials(const dem::ModelSpec& spec);
 
-}  // namespace app
+}  // namespace scene

@@ -8,7 +8,7 @@
 #include "scene/physics_keys.hpp"
 #include "scene/toml_reader.hpp"
 
-namespace app {
+namespace scene {
 
 namespace {
 
@@ -173,7 +173,7 @@ std::vector<dem::Material> default_materials() {
 
 PipelineScene::PipelineScene() {
   spec.materials = default_materials();
-  spec.rolling = dem::RollingLaw::epsd;
+  spec.law.rolling = "epsd";
   spec.max_impact_speed = 1.0;
   spec.stop_overlap = 0.25;
 }
@@ -251,4 +251,4 @@ std::string scene_keys_markdown() {
       markdown_table(interaction_keys(), InteractionEntry{}, "interactions[]."));
 }
 
-}  // namespace app
+}  // namespace scene

@@ -12,7 +12,7 @@
 #include "dem/model.hpp"
 #include "scene/scene_keys.hpp"
 
-namespace app {
+namespace scene {
 
 struct PipelineScene {
   std::string source = "(defaults)";  // the scene file, or the defaults
@@ -88,4 +88,4 @@ std::string describe(const PipelineScene& scene);
 // The Markdown reference of every key (docs/INTERFACE.md, "Scene keys", is generated from it).
 std::string scene_keys_markdown();
 
-}  // namespace app
+}  // namespace scene

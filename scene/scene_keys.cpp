@@ -7,7 +7,7 @@
 
 #include "core/error.hpp"
 
-namespace app {
+namespace scene {
 
 bool ValueRange::contains(double x) const {
   if (!std::isfinite(x)) return false;
@@ -146,4 +146,4 @@ std::string_view shapes_name(Shapes shapes) {
   return "";
 }
 
-}  // namespace app
+}  // namespace scene

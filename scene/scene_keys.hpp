@@ -17,7 +17,7 @@
 #include "dem/types.hpp"
 #include "scene/toml_reader.hpp"
 
-namespace app {
+namespace scene {
 
 enum class KeyType : std::uint8_t {
   number,          // a real number in the key's unit
@@ -147,7 +147,11 @@ std::string describe_table(const KeyTable<Target>& keys, std::string_view table,
     if (key.type == KeyType::path && std::get<std::string>(value).empty()) continue;
     std::string line = std::string(key.name) + " = " + toml_value(value, key.type);
     line.resize(std::max<std::size_t>(line.size() + 1, 32), ' ');
-    std::string comment = (key.unit.empty() ? std::string() : "[" + std::string(key.unit) + "] ") + std::string(key.meaning);
+    // Appended piece by piece: `"[" + std::string(unit)` inlines to a copy GCC 12 takes for an
+    // overlapping one (-Wrestrict, a false positive; warnings are errors).
+    std::string comment;
+    if (!key.unit.empty()) comment.append("[").append(key.unit).append("] ");
+    comment.append(key.meaning);
     while (!comment.empty() && comment.back() == ' ') comment.pop_back();
     out += line + "# " + comment + "\n";
   }
@@ -186,4 +190,4 @@ std::string markdown_table(const KeyTable<Target>& keys, const Target& defaults,
   return out;
 }
 
-}  // namespace app
+}  // namespace scene

@@ -10,7 +10,7 @@
 #include "scene/physics_keys.hpp"
 #include "scene/toml_reader.hpp"
 
-namespace app {
+namespace scene {
 
 namespace fs = std::filesystem;
 
@@ -224,4 +224,4 @@ SimulationScene load_simulation_scene(const fs::path& path, const std::vector<st
   return scene;
 }
 
-}  // namespace app
+}  // namespace scene

@@ -10,7 +10,7 @@
 #include "dem/model.hpp"
 #include "dem/state.hpp"
 
-namespace app {
+namespace scene {
 
 struct OutputSettings {
   std::filesystem::path directory = "out/simulation";
@@ -31,4 +31,4 @@ struct SimulationScene {
 
 SimulationScene load_simulation_scene(const std::filesystem::path& path, const std::vector<std::string>& overrides);
 
-}  // namespace app
+}  // namespace scene

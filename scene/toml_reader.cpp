@@ -7,7 +7,7 @@
 
 #include "core/error.hpp"
 
-namespace app {
+namespace scene {
 
 using diefill::InputError;
 
@@ -205,4 +205,4 @@ void Table::finish() const {
                        "unknown key", "Check the spelling; `diefill scene` prints every key with its default");
 }
 
-}  // namespace app
+}  // namespace scene

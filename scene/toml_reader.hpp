@@ -11,7 +11,7 @@
 
 #include "dem/types.hpp"
 
-namespace app {
+namespace scene {
 
 class TomlDocument;
 
@@ -67,4 +67,4 @@ class TomlDocument {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace app
+}  // namespace scene

@@ -6,13 +6,14 @@ set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
 build_dir=build
-cmake_args=(-DCMAKE_BUILD_TYPE=Release)
+# Warnings are errors: the toolchain is Debian 12's g++, which setup installs, so a warning is ours.
+cmake_args=(-DCMAKE_BUILD_TYPE=Release -DDIEFILL_WERROR=ON)
 targets=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --build-dir) build_dir="$2"; shift 2 ;;
     # Release flags, to which our own targets add -O0 and the sanitizers (cmake/Warnings.cmake).
-    --sanitize) cmake_args=(-DCMAKE_BUILD_TYPE=Release -DDIEFILL_SANITIZE=ON); shift ;;
+    --sanitize) cmake_args=(-DCMAKE_BUILD_TYPE=Release -DDIEFILL_WERROR=ON -DDIEFILL_SANITIZE=ON); shift ;;
     *) targets+=("$1"); shift ;;
   esac
 done

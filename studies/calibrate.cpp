@@ -4,7 +4,6 @@
 #include "studies/calibrate.hpp"
 
 #include <fmt/core.h>
-#include <omp.h>
 
 #include <cmath>
 #include <fstream>
@@ -20,10 +19,11 @@
 #include "mesh/shapes.hpp"
 #include "mesh/sdf.hpp"
 #include "pipeline/throughput.hpp"
+#include "pipeline/run_loop.hpp"
 #include "studies/calibrate_fit.hpp"
 #include "studies/study_scenes.hpp"
 
-namespace app::study {
+namespace studies {
 
 namespace fs = std::filesystem;
 
@@ -32,11 +32,11 @@ double beverloo_orifice(double orifice, double d) {
   return std::sqrt(9.81) * std::pow(std::max(0.0, orifice - beverloo_k * d), 2.5);
 }
 
-SimulatedTests simulated_tests(const PipelineScene& scene, const MeasuredPowder& m, double orifice_grains) {
-  PipelineScene s = scene;
+SimulatedTests simulated_tests(const scene::PipelineScene& scene, const MeasuredPowder& m, double orifice_grains) {
+  scene::PipelineScene s = scene;
   s.particle_diameter = m.particle_diameter;
   s.diameter_spread = m.diameter_spread;
-  s.spec.materials[std::size_t(material_named(s.spec, "powder"))].density = m.material_density;
+  s.spec.materials[std::size_t(scene::material_named(s.spec, "powder"))].density = m.material_density;
   // As coarse as keeps the orifice `orifice_grains` grains wide: Beverloo's k·d then corrects
   // the boundary (docs/PHYSICS.md §4), and every test holds the same few thousand grains
   // whatever the real powder's size.
@@ -215,7 +215,7 @@ void record_test(const fs::path& file, const std::string& key, const TestResults
 
 // The wall time the design will take on this machine, before any test runs: the tests'
 // particle-steps over the kernel's measured rate at a fill's efficiency (pipeline/throughput.hpp).
-double estimated_seconds(const PipelineScene& scene, const SimulatedTests& t, std::size_t tests, const fs::path& cache) {
+double estimated_seconds(const scene::PipelineScene& scene, const SimulatedTests& t, std::size_t tests, const fs::path& cache) {
   const Powder& p = t.powder;
   dem::State one;
   dem::InsertRegion region;
@@ -230,18 +230,18 @@ double estimated_seconds(const PipelineScene& scene, const SimulatedTests& t, st
   const double rate = 0.58 * 0.6 * p.density * beverloo_orifice(2 * f.orifice_radius, p.diameter);
   const double drain = 0.2 + 0.4 * bed_grains * grain_volume(p.diameter) * p.density / rate;
   const double particle_steps = (double(heap.grains) * (0.5 + heap.settle_time) + bed_grains * drain) / dt;
-  const GrainSizing grains{p.diameter, p.r_max(), 1, 0};
-  const double kernel = kernel_rate(scene, grains, cache);
-  return double(tests) * TimeModel{}.predict(particle_steps, kernel);
+  const pipeline::GrainSizing grains{p.diameter, p.r_max(), 1, 0};
+  const double kernel = pipeline::kernel_rate(scene, grains, cache);
+  return double(tests) * pipeline::TimeModel{}.predict(particle_steps, kernel);
 }
 
 }  // namespace
 
 int run_calibrate(const CalibrateRequest& c) {
   const MeasuredPowder measured = read_measured_powder(c.measured);
-  PipelineScene scene = load_pipeline_scene(std::nullopt, c.overrides);
+  scene::PipelineScene scene = scene::load_pipeline_scene(std::nullopt, c.overrides);
   if (c.threads) scene.threads = *c.threads;
-  if (scene.threads > 0) omp_set_num_threads(scene.threads);
+  const pipeline::ThreadCount threads(scene.threads);
   const SimulatedTests tests = simulated_tests(scene, measured, 6);
   fs::create_directories(c.out);
   const fs::path checkpoint = checkpoint_of(c.out);
@@ -280,4 +280,4 @@ int run_calibrate(const CalibrateRequest& c) {
   return 0;
 }
 
-}  // namespace app::study
+}  // namespace studies

@@ -14,7 +14,7 @@
 #include "studies/measured_powder.hpp"
 #include "studies/study_kit.hpp"
 
-namespace app::study {
+namespace studies {
 
 struct CalibrateRequest {
   std::filesystem::path measured;
@@ -43,7 +43,7 @@ struct SimulatedTests {
   double orifice_grains = 6;
   double funnel_half_angle_deg = 30;
 };
-SimulatedTests simulated_tests(const PipelineScene& scene, const MeasuredPowder& measured, double orifice_grains);
+SimulatedTests simulated_tests(const scene::PipelineScene& scene, const MeasuredPowder& measured, double orifice_grains);
 
 // What the tests give for one pair of frictions: the heap's angle [°], the orifice's C and the
 // poured bed's solid fraction.
@@ -52,4 +52,4 @@ struct TestResults {
 };
 TestResults run_tests(const SimulatedTests& tests, double sliding, double rolling, std::uint64_t seed, const std::string& label);
 
-}  // namespace app::study
+}  // namespace studies

@@ -11,7 +11,7 @@
 #include "core/atomic_file.hpp"
 #include "core/log.hpp"
 
-namespace app::study {
+namespace studies {
 
 namespace {
 
@@ -47,7 +47,14 @@ void fit_map(ObservableFit& o, const std::vector<Finished>& tests, double TestRe
     for (int l = 0; l < 4; ++l) o.design_inverse[k][l] = inverse(k, l);
   }
   const double dof = double(tests.size()) - 4;
-  o.scatter = dof > 0 ? std::sqrt((x * b - y).squaredNorm() / dof) : 0;
+  // Row by row: GCC 12 takes Eigen's freeing of the temporary x b - y for a use after free
+  // (-Wuse-after-free, a false positive; warnings are errors).
+  double squared = 0;
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    const double residual = x.row(i).dot(b) - y[i];
+    squared += residual * residual;
+  }
+  o.scatter = dof > 0 ? std::sqrt(squared / dof) : 0;
 }
 
 ObservableFit observable(std::string name, std::string unit, double measured, double measured_error) {
@@ -224,4 +231,4 @@ void write_calibration(const std::filesystem::path& out, const MeasuredPowder& m
                      fit.sliding_pinned ? "" : " (not pinned)", fit.rolling, fit.rolling_ci, fit.rolling_pinned ? "" : " (not pinned)");
 }
 
-}  // namespace app::study
+}  // namespace studies

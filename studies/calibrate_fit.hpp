@@ -8,7 +8,7 @@
 
 #include "studies/calibrate.hpp"
 
-namespace app::study {
+namespace studies {
 
 struct DesignPoint {
   double sliding = 0, rolling = 0;
@@ -52,4 +52,4 @@ CalibrationFit fit_frictions(const std::vector<Finished>& tests, const MeasuredP
 void write_calibration(const std::filesystem::path& out, const MeasuredPowder& measured, const SimulatedTests& simulated,
                        const std::vector<Finished>& tests, const CalibrationFit& fit);
 
-}  // namespace app::study
+}  // namespace studies

@@ -11,7 +11,7 @@
 #include "studies/calibrate.hpp"
 #include "studies/studies.hpp"
 
-namespace app::study {
+namespace studies {
 
 namespace {
 
@@ -29,7 +29,7 @@ MeasuredPowder lab_powder(double diameter) {
 
 // The twin's tests, repeated, as the lab's file: the means, and the angle's and the rate's
 // standard errors (the defaults' when a test ran once).
-MeasuredPowder measure_twin(const PipelineScene& scene, const MeasuredPowder& lab, double sliding, double rolling, int repeats) {
+MeasuredPowder measure_twin(const scene::PipelineScene& scene, const MeasuredPowder& lab, double sliding, double rolling, int repeats) {
   const SimulatedTests twin = simulated_tests(scene, lab, 8);
   std::vector<double> angle, c, phi;
   for (int k = 0; k < repeats; ++k) {
@@ -47,7 +47,7 @@ MeasuredPowder measure_twin(const PipelineScene& scene, const MeasuredPowder& la
 
 }  // namespace
 
-void calibration_round_trip(const PipelineScene& scene, bool reduced, Output& out) {
+void calibration_round_trip(const scene::PipelineScene& scene, bool reduced, Output& out) {
   const double sliding = 0.4, rolling = 0.12;
   // Reduced: each test once, and coarser (2 mm grains: 4 mm spheres, the twin's 3 mm), so that
   // the suite's round trip takes about two minutes; by default four seeds a test, 1.2 mm grains.
@@ -74,4 +74,4 @@ void calibration_round_trip(const PipelineScene& scene, bool reduced, Output& ou
     out.results[name]["error"] = out.results[name]["value"].get<double>() - (name[0] == 's' ? sliding : rolling);
 }
 
-}  // namespace app::study
+}  // namespace studies

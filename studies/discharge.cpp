@@ -17,7 +17,7 @@
 #include "mesh/import.hpp"
 #include "mesh/shapes.hpp"
 
-namespace app::study {
+namespace studies {
 
 namespace {
 
@@ -115,39 +115,46 @@ std::vector<double> sweep(double lo, double hi, int n) {
   return x;
 }
 
-}  // namespace
+// The slot container of (a), for the slot `b_over_d` grains wide.
+SlotContainer slot_container(const DischargeSizes& z, double d, double b_over_d) {
+  SlotContainer c;
+  c.slot_width = b_over_d * d;
+  c.length = (z.slot_widths.back() + 2 * 12) * d;
+  c.width = z.container_width * d;
+  c.fill_height = z.fill_height * d;
+  c.flow_time = z.flow_time;
+  c.stop_after_steady_flow = true;  // the draining rest, a third of the cost, is not read
+  return c;
+}
 
-void discharge(const PipelineScene& scene, bool reduced, Output& out) {
-  const Powder powder = powder_of(scene);
-  const DischargeSizes z = discharge_sizes(reduced);
-  const double d = powder.diameter, g = powder.spec.gravity.norm();
-
-  // (a) Slot flow: each bed, settled once on the shut gate, drained through every slot width, so
-  // that the widths' rates share their beds. One bed's rates scatter by 3-5 % from seed to seed
-  // (two realisations: 23.6 and 23.0 g/s at 5.2 mm, 71.9 and 68.4 g/s at 9.6 mm), as much as the
-  // slot law's residuals under test: hence the beds, pooled (study_kit.hpp).
+// (a)'s rates, pooled over the beds, per slot width.
+struct SlotFlow {
   std::vector<double> widths, rates, errors, densities;
   std::vector<std::vector<nlohmann::json>> rows;
   nlohmann::json bed_rates = nlohmann::json::array();
   Chart histories{"slot_discharge.png", "Discharged mass after the slot opens (first bed)", "time [s]", "discharged mass [g]"};
-  const auto container = [&](double b_over_d) {
-    SlotContainer c;
-    c.slot_width = b_over_d * d;
-    c.length = (z.slot_widths.back() + 2 * 12) * d;
-    c.width = z.container_width * d;
-    c.fill_height = z.fill_height * d;
-    c.flow_time = z.flow_time;
-    c.stop_after_steady_flow = true;  // the draining rest, a third of the cost, is not read
-    return c;
-  };
+};
+
+std::vector<SlotBed> settle_beds(const Powder& powder, const DischargeSizes& z) {
   std::vector<SlotBed> beds;
   for (int bed = 0; bed < z.beds; ++bed) {
     Powder seeded = powder;
     seeded.seed += std::uint64_t(bed);
-    beds.push_back(settle_slot_bed(seeded, container(z.slot_widths.front()), fmt::format("discharge: bed {} of {}", bed + 1, z.beds)));
+    beds.push_back(settle_slot_bed(seeded, slot_container(z, powder.diameter, z.slot_widths.front()),
+                                   fmt::format("discharge: bed {} of {}", bed + 1, z.beds)));
   }
+  return beds;
+}
+
+// (a) Slot flow: each bed, settled once on the shut gate, drained through every slot width, so
+// that the widths' rates share their beds. One bed's rates scatter by 3-5 % from seed to seed
+// (two realisations: 23.6 and 23.0 g/s at 5.2 mm, 71.9 and 68.4 g/s at 9.6 mm), as much as the
+// slot law's residuals under test: hence the beds, pooled (study_kit.hpp).
+SlotFlow measure_slot_flow(const Powder& powder, const DischargeSizes& z) {
+  SlotFlow slot;
+  const std::vector<SlotBed> beds = settle_beds(powder, z);
   for (double b_over_d : z.slot_widths) {
-    const SlotContainer c = container(b_over_d);
+    const SlotContainer c = slot_container(z, powder.diameter, b_over_d);
     std::vector<MeanAndError> per_bed;
     double density = 0, mass = 0;
     std::size_t samples = 0;
@@ -162,76 +169,121 @@ void discharge(const PipelineScene& scene, bool reduced, Output& out) {
       if (bed > 0) continue;
       Series h{fmt::format("b = {:.3g} mm", c.slot_width * 1e3), run.time, {}, {}, "line"};
       for (double m : run.discharged) h.y.push_back(m * 1e3);
-      histories.series.push_back(h);
+      slot.histories.series.push_back(h);
     }
     const MeanAndError rate = pooled(per_bed);
-    widths.push_back(c.slot_width);
-    rates.push_back(rate.mean);
-    errors.push_back(rate.error);
-    densities.push_back(density);
+    slot.widths.push_back(c.slot_width);
+    slot.rates.push_back(rate.mean);
+    slot.errors.push_back(rate.error);
+    slot.densities.push_back(density);
     nlohmann::json each = nlohmann::json::array();
     for (const MeanAndError& r : per_bed) each.push_back(r.mean);
-    bed_rates.push_back(each);
-    rows.push_back({c.slot_width, rate.mean, rate.error, density, mass, samples});
+    slot.bed_rates.push_back(each);
+    slot.rows.push_back({c.slot_width, rate.mean, rate.error, density, mass, samples});
   }
-  out.table("slot_flow.csv", {"slot_width_m", "rate_kg_s", "rate_error_kg_s", "bulk_density_kg_m3", "bed_mass_kg", "samples"},
-            rows);
-  double bulk_density = 0;
-  for (double rho : densities) bulk_density += rho / double(densities.size());
-  const double slot_length = z.container_width * d;
-  const BeverlooFit fit = fit_beverloo(widths, rates, slot_length, d);
-  const double scale = bulk_density * std::sqrt(g);
-  const double c_s = fit.a / scale, c_s_error = fit.a_error / scale;
+  return slot;
+}
+
+// (a)'s rates fitted to the Beverloo slot law, C_s free and at its published value.
+struct SlotLaw {
+  double bulk_density = 0, slot_length = 0;
+  BeverlooFit fit, published;
+  double c_s = 0, c_s_error = 0;
+};
+
+SlotLaw fit_slot_law(const SlotFlow& slot, const DischargeSizes& z, double d, double g) {
+  SlotLaw law;
+  for (double rho : slot.densities) law.bulk_density += rho / double(slot.densities.size());
+  law.slot_length = z.container_width * d;
+  law.fit = fit_beverloo(slot.widths, slot.rates, law.slot_length, d);
+  const double scale = law.bulk_density * std::sqrt(g);
+  law.c_s = law.fit.a / scale, law.c_s_error = law.fit.a_error / scale;
   // The slot law's published coefficient (docs/PHYSICS.md §3): the k it needs, and how well it fits.
-  const BeverlooFit published = fit_beverloo(widths, rates, slot_length, d, published_slot_c * scale);
+  law.published = fit_beverloo(slot.widths, slot.rates, law.slot_length, d, published_slot_c * scale);
   diefill::log::info("discharge: Beverloo slot law C_s = {:.3f} ± {:.3f}, k = {:.2f} ± {:.2f} (bulk density {:.0f} kg/m³); "
                      "with the published C_s = {:.2f}, k = {:.2f} ± {:.2f} (residual {:.1f} %)",
-                     c_s, c_s_error, fit.k, fit.k_error, bulk_density, published_slot_c, published.k, published.k_error,
-                     100 * published.rms_relative_residual);
+                     law.c_s, law.c_s_error, law.fit.k, law.fit.k_error, law.bulk_density, published_slot_c, law.published.k,
+                     law.published.k_error, 100 * law.published.rms_relative_residual);
+  return law;
+}
 
+void chart_slot_flow(const SlotFlow& slot, const SlotLaw& law, double d, Output& out) {
   Chart flow{"beverloo.png", "Slot discharge against the Beverloo slot law", "slot width b [mm]", "mass flow rate [g/s]"};
   Series measured{"DEM", {}, {}, {}, "points"};
-  for (std::size_t i = 0; i < widths.size(); ++i)
-    measured.x.push_back(widths[i] * 1e3), measured.y.push_back(rates[i] * 1e3), measured.error.push_back(errors[i] * 1e3);
-  Series law_curve{fmt::format("Beverloo: C_s = {:.2f}, k = {:.2f}", c_s, fit.k), {}, {}, {}, "line"};
-  for (double b : sweep(fit.k * d, widths.back() * 1.1, 60))
-    law_curve.x.push_back(b * 1e3), law_curve.y.push_back(fit.rate(slot_length, b, d) * 1e3);
+  for (std::size_t i = 0; i < slot.widths.size(); ++i)
+    measured.x.push_back(slot.widths[i] * 1e3), measured.y.push_back(slot.rates[i] * 1e3),
+        measured.error.push_back(slot.errors[i] * 1e3);
+  Series law_curve{fmt::format("Beverloo: C_s = {:.2f}, k = {:.2f}", law.c_s, law.fit.k), {}, {}, {}, "line"};
+  for (double b : sweep(law.fit.k * d, slot.widths.back() * 1.1, 60))
+    law_curve.x.push_back(b * 1e3), law_curve.y.push_back(law.fit.rate(law.slot_length, b, d) * 1e3);
   flow.series = {measured, law_curve};
   out.chart(flow);
-  out.chart(histories);
+  out.chart(slot.histories);
+}
 
-  // (b) The shoe over a deep die: delivered mass against speed.
-  const double shoe_d = z.shoe_coarsening * d;
-  const double opening = z.opening * shoe_d, depth = z.bin_depth * shoe_d;
-  const std::filesystem::path bin = out.work() / "bin.stl";
+// (b)'s deep die under the moving shoe, whose grains are coarser than the slot's.
+struct DeepDie {
+  double shoe_d = 0, opening = 0, depth = 0, capacity = 0;
+  std::filesystem::path bin;
+};
+
+DeepDie deep_die(const DischargeSizes& z, double d, double bulk_density, Output& out) {
+  DeepDie die;
+  die.shoe_d = z.shoe_coarsening * d;
+  die.opening = z.opening * die.shoe_d, die.depth = z.bin_depth * die.shoe_d;
+  die.bin = out.work() / "bin.stl";
   std::filesystem::create_directories(out.work());
-  mesh::write_stl(mesh::box_solid(Vec3(-0.5 * opening, -0.5 * opening, -depth), Vec3(0.5 * opening, 0.5 * opening, 0)), bin,
-                  mesh::LengthUnit::mm, "diefill discharge study: deep die");
-  const double capacity = bulk_density * opening * opening * depth;
-  // The law's mass, capped by what the die holds.
-  const auto law_mass = [&](double v) {
-    return std::min(capacity, moving_container_mass(fit, shoe_d, scene.shoe_length, opening, opening, v));
-  };
+  mesh::write_stl(
+      mesh::box_solid(Vec3(-0.5 * die.opening, -0.5 * die.opening, -die.depth), Vec3(0.5 * die.opening, 0.5 * die.opening, 0)),
+      die.bin, mesh::LengthUnit::mm, "diefill discharge study: deep die");
+  die.capacity = bulk_density * die.opening * die.opening * die.depth;
+  return die;
+}
+
+// The law's mass, capped by what the die holds.
+double law_mass(const SlotLaw& law, const DeepDie& die, double shoe_length, double v) {
+  return std::min(die.capacity, moving_container_mass(law.fit, die.shoe_d, shoe_length, die.opening, die.opening, v));
+}
+
+// (b)'s delivered masses, one run of the pipeline per speed.
+struct ShoeRuns {
   std::vector<double> law_error;
   std::vector<double> speeds, delivered;
-  std::vector<std::vector<nlohmann::json>> shoe_rows;
+  std::vector<std::vector<nlohmann::json>> rows;
+};
+
+ShoeRuns run_moving_shoe(const scene::PipelineScene& scene, const DischargeSizes& z, const SlotLaw& law, const DeepDie& die,
+                         Output& out) {
+  ShoeRuns shoe;
   for (double v : z.speeds) {
-    PipelineScene s = scene;
+    scene::PipelineScene s = scene;
     s.die_units = "mm";
     s.speed = v;
     s.acceleration = 10;  // about 1 g: the shoe reaches its speed before the opening
     s.start_gap = v * v / (2 * s.acceleration) + 2e-3;
-    s.fill_height = z.shoe_fill * shoe_d;
+    s.fill_height = z.shoe_fill * die.shoe_d;
     s.coarse_graining = scene.coarse_graining * z.shoe_coarsening;
     s.out = out.work() / fmt::format("shoe_{:.3f}_m_s", v);
-    const DieRun run = run_die_fill(s, bin, false);
+    const pipeline::DieRun run = pipeline::run_die_fill(s, die.bin, false);
     const double mass = run.report["fill"].value("mass_kg", 0.0);
-    speeds.push_back(v);
-    delivered.push_back(mass);
-    law_error.push_back(mass / law_mass(v) - 1);
-    shoe_rows.push_back({v, mass, mass / capacity, law_mass(v)});
+    shoe.speeds.push_back(v);
+    shoe.delivered.push_back(mass);
+    shoe.law_error.push_back(mass / law_mass(law, die, scene.shoe_length, v) - 1);
+    shoe.rows.push_back({v, mass, mass / die.capacity, law_mass(law, die, scene.shoe_length, v)});
   }
-  // Critical velocity: delta = (v_c / v)^n where the die is clearly not full.
+  return shoe;
+}
+
+struct CriticalVelocity {
+  LineFit power;
+  double n = 0, v_c = 0, v_c_error = 0;
+  bool falls = true;  // the delivered mass falls with speed above v_c
+};
+
+// Critical velocity: delta = (v_c / v)^n where the die is clearly not full.
+CriticalVelocity fit_critical_velocity(const ShoeRuns& shoe, double capacity) {
+  const std::vector<double>& speeds = shoe.speeds;
+  const std::vector<double>& delivered = shoe.delivered;
   std::vector<double> log_v, log_delta;
   for (std::size_t i = 0; i < speeds.size(); ++i)
     if (delivered[i] < 0.9 * capacity && delivered[i] > 0)
@@ -243,49 +295,81 @@ void discharge(const PipelineScene& scene, bool reduced, Output& out) {
   bool falls = true;
   for (std::size_t i = 1; i < speeds.size(); ++i)
     if (speeds[i] > v_c && delivered[i] >= delivered[i - 1]) falls = false;
-  out.table("moving_shoe.csv", {"speed_m_s", "delivered_kg", "fill_ratio", "moving_container_law_kg"}, shoe_rows);
+  return {power, n, v_c, v_c_error, falls};
+}
 
+void chart_moving_shoe(const ShoeRuns& shoe, const CriticalVelocity& critical_fit, const SlotLaw& law, const DeepDie& die,
+                       double shoe_length, Output& out) {
+  const double v_c = critical_fit.v_c, n = critical_fit.n;
   Chart mass_chart{"moving_shoe.png", "Mass a moving shoe delivers into a deep die", "shoe speed [m/s]", "delivered mass [g]"};
   mass_chart.log_x = mass_chart.log_y = true;
-  Series dem_points{"DEM", speeds, {}, {}, "points"};
-  for (double m : delivered) dem_points.y.push_back(m * 1e3);
+  Series dem_points{"DEM", shoe.speeds, {}, {}, "points"};
+  for (double m : shoe.delivered) dem_points.y.push_back(m * 1e3);
   Series container_law{"moving-container law (from the slot fit)", {}, {}, {}, "line"};
   Series critical{fmt::format("critical velocity: v_c = {:.3f} m/s, n = {:.2f}", v_c, n), {}, {}, {}, "line"};
-  for (double v : sweep(speeds.front() * 0.8, speeds.back() * 1.2, 60)) {
+  for (double v : sweep(shoe.speeds.front() * 0.8, shoe.speeds.back() * 1.2, 60)) {
     container_law.x.push_back(v);
-    container_law.y.push_back(law_mass(v) * 1e3);
+    container_law.y.push_back(law_mass(law, die, shoe_length, v) * 1e3);
     critical.x.push_back(v);
-    critical.y.push_back(capacity * (v <= v_c ? 1.0 : std::pow(v_c / v, n)) * 1e3);
+    critical.y.push_back(die.capacity * (v <= v_c ? 1.0 : std::pow(v_c / v, n)) * 1e3);
   }
   mass_chart.series = {dem_points, container_law, critical};
   out.chart(mass_chart);
-
-  out.results = {
-      {"grain_diameter_m", d},
-      {"shoe_grain_diameter_m", shoe_d},
-      {"slot",
-       {{"length_m", slot_length},
-        {"widths_m", widths},
-        {"rates_kg_s", rates},
-        {"rate_errors_kg_s", errors},
-        {"beds", z.beds},
-        {"bed_rates_kg_s", bed_rates},
-        {"bulk_density_kg_m3", bulk_density},
-        {"beverloo", {{"C_s", c_s}, {"C_s_error", c_s_error}, {"k", fit.k}, {"k_error", fit.k_error},
-                      {"rms_relative_residual", fit.rms_relative_residual}}},
-        {"beverloo_published_C_s", {{"C_s", published_slot_c}, {"k", published.k}, {"k_error", published.k_error},
-                                    {"rms_relative_residual", published.rms_relative_residual}}}}},
-      {"moving_shoe",
-       {{"opening_m", {opening, opening}},
-        {"depth_m", depth},
-        {"capacity_kg", capacity},
-        {"shoe_length_m", scene.shoe_length},
-        {"speeds_m_s", speeds},
-        {"delivered_kg", delivered},
-        {"moving_container_law_relative_error", law_error},
-        {"critical_velocity", {{"v_c_m_s", v_c}, {"v_c_error_m_s", v_c_error}, {"n", n}, {"n_error", power.slope_error},
-                               {"points", power.points}}},
-        {"delivered_mass_falls_above_v_c", falls}}}};
 }
 
-}  // namespace app::study
+nlohmann::json slot_results(const SlotFlow& slot, const SlotLaw& law, const DischargeSizes& z) {
+  const BeverlooFit& fit = law.fit;
+  const BeverlooFit& published = law.published;
+  return {{"length_m", law.slot_length},
+          {"widths_m", slot.widths},
+          {"rates_kg_s", slot.rates},
+          {"rate_errors_kg_s", slot.errors},
+          {"beds", z.beds},
+          {"bed_rates_kg_s", slot.bed_rates},
+          {"bulk_density_kg_m3", law.bulk_density},
+          {"beverloo", {{"C_s", law.c_s}, {"C_s_error", law.c_s_error}, {"k", fit.k}, {"k_error", fit.k_error},
+                        {"rms_relative_residual", fit.rms_relative_residual}}},
+          {"beverloo_published_C_s", {{"C_s", published_slot_c}, {"k", published.k}, {"k_error", published.k_error},
+                                      {"rms_relative_residual", published.rms_relative_residual}}}};
+}
+
+nlohmann::json moving_shoe_results(const ShoeRuns& shoe, const CriticalVelocity& c, const DeepDie& die, double shoe_length) {
+  return {{"opening_m", {die.opening, die.opening}},
+          {"depth_m", die.depth},
+          {"capacity_kg", die.capacity},
+          {"shoe_length_m", shoe_length},
+          {"speeds_m_s", shoe.speeds},
+          {"delivered_kg", shoe.delivered},
+          {"moving_container_law_relative_error", shoe.law_error},
+          {"critical_velocity", {{"v_c_m_s", c.v_c}, {"v_c_error_m_s", c.v_c_error}, {"n", c.n}, {"n_error", c.power.slope_error},
+                                 {"points", c.power.points}}},
+          {"delivered_mass_falls_above_v_c", c.falls}};
+}
+
+}  // namespace
+
+void discharge(const scene::PipelineScene& scene, bool reduced, Output& out) {
+  const Powder powder = powder_of(scene);
+  const DischargeSizes z = discharge_sizes(reduced);
+  const double d = powder.diameter, g = powder.spec.gravity.norm();
+
+  const SlotFlow slot = measure_slot_flow(powder, z);
+  out.table("slot_flow.csv", {"slot_width_m", "rate_kg_s", "rate_error_kg_s", "bulk_density_kg_m3", "bed_mass_kg", "samples"},
+            slot.rows);
+  const SlotLaw law = fit_slot_law(slot, z, d, g);
+  chart_slot_flow(slot, law, d, out);
+
+  // (b) The shoe over a deep die: delivered mass against speed.
+  const DeepDie die = deep_die(z, d, law.bulk_density, out);
+  const ShoeRuns shoe = run_moving_shoe(scene, z, law, die, out);
+  const CriticalVelocity critical = fit_critical_velocity(shoe, die.capacity);
+  out.table("moving_shoe.csv", {"speed_m_s", "delivered_kg", "fill_ratio", "moving_container_law_kg"}, shoe.rows);
+  chart_moving_shoe(shoe, critical, law, die, scene.shoe_length, out);
+
+  out.results = {{"grain_diameter_m", d},
+                 {"shoe_grain_diameter_m", die.shoe_d},
+                 {"slot", slot_results(slot, law, z)},
+                 {"moving_shoe", moving_shoe_results(shoe, critical, die, scene.shoe_length)}};
+}
+
+}  // namespace studies

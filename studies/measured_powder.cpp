@@ -5,12 +5,12 @@
 #include "core/error.hpp"
 #include "scene/toml_reader.hpp"
 
-namespace app::study {
+namespace studies {
 
 namespace {
 
 // A number that must lie in [lo, hi]: absent or outside, the error names the table and the key.
-double bounded(Table& t, const std::string& key, double lo, double hi, const char* unit, std::optional<double> fallback = {}) {
+double bounded(scene::Table& t, const std::string& key, double lo, double hi, const char* unit, std::optional<double> fallback = {}) {
   const std::optional<double> v = t.number(key);
   if (!v && fallback) return *fallback;
   if (!v) t.fail(key, "is missing", fmt::format("Give it in {} (between {:g} and {:g})", unit, lo, hi));
@@ -18,8 +18,8 @@ double bounded(Table& t, const std::string& key, double lo, double hi, const cha
   return *v;
 }
 
-Table required_table(Table& root, const std::string& name, const std::string& holds) {
-  std::optional<Table> t = root.table(name);
+scene::Table required_table(scene::Table& root, const std::string& name, const std::string& holds) {
+  std::optional<scene::Table> t = root.table(name);
   if (!t) root.fail(name, "is missing", "Add a [" + name + "] table with " + holds);
   return *t;
 }
@@ -27,25 +27,25 @@ Table required_table(Table& root, const std::string& name, const std::string& ho
 }  // namespace
 
 MeasuredPowder read_measured_powder(const std::filesystem::path& file) {
-  TomlDocument doc = TomlDocument::parse(file);
-  Table root = doc.root();
+  scene::TomlDocument doc = scene::TomlDocument::parse(file);
+  scene::Table root = doc.root();
   MeasuredPowder m;
   m.source = file.string();
-  Table powder = required_table(root, "powder", "particle_diameter, material_density and apparent_density");
+  scene::Table powder = required_table(root, "powder", "particle_diameter, material_density and apparent_density");
   m.particle_diameter = bounded(powder, "particle_diameter", 1e-6, 5e-3, "m");
   m.diameter_spread = bounded(powder, "diameter_spread", 0, 0.5, "(relative half-width)", m.diameter_spread);
   m.material_density = bounded(powder, "material_density", 100, 25000, "kg/m³");
   m.apparent_density = bounded(powder, "apparent_density", 1, m.material_density, "kg/m³ (at most the material density)");
   powder.finish();
 
-  Table repose = required_table(root, "repose", "angle_deg (a fixed-base funnel heap)");
+  scene::Table repose = required_table(root, "repose", "angle_deg (a fixed-base funnel heap)");
   if (const auto method = repose.string("method"); method && *method != "fixed_base_heap")
     repose.fail("method", "is \"" + *method + "\"; only the fixed-base funnel heap is simulated", "Write method = \"fixed_base_heap\"");
   m.repose_deg = bounded(repose, "angle_deg", 5, 70, "°");
   m.repose_error_deg = bounded(repose, "angle_error_deg", 0.1, 10, "°", m.repose_error_deg);
   repose.finish();
 
-  Table flow = required_table(root, "flow", "orifice_diameter and mass_flow_rate (or mass and time)");
+  scene::Table flow = required_table(root, "flow", "orifice_diameter and mass_flow_rate (or mass and time)");
   m.orifice_diameter = bounded(flow, "orifice_diameter", 1e-4, 0.1, "m");
   m.funnel_half_angle_deg = bounded(flow, "funnel_half_angle_deg", 10, 90, "°", m.funnel_half_angle_deg);
   const bool as_rate = flow.has("mass_flow_rate");
@@ -66,8 +66,8 @@ MeasuredPowder read_measured_powder(const std::filesystem::path& file) {
 
 bool is_measured_powder(const std::filesystem::path& file) {
   if (file.extension() != ".toml" || !std::filesystem::is_regular_file(file)) return false;
-  TomlDocument doc = TomlDocument::parse(file);
-  const Table root = doc.root();
+  scene::TomlDocument doc = scene::TomlDocument::parse(file);
+  const scene::Table root = doc.root();
   return root.has("repose") || root.has("flow");
 }
 
@@ -80,4 +80,4 @@ std::string measured_powder_toml(const MeasuredPowder& m) {
       m.orifice_diameter, m.funnel_half_angle_deg, m.flow_rate, m.flow_rate_error);
 }
 
-}  // namespace app::study
+}  // namespace studies

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <string>
 
-namespace app::study {
+namespace studies {
 
 struct MeasuredPowder {
   std::string source;               // the file, for messages
@@ -32,4 +32,4 @@ bool is_measured_powder(const std::filesystem::path& file);
 // The same as TOML, as read_measured_powder reads it (the round-trip test writes its twin's).
 std::string measured_powder_toml(const MeasuredPowder& m);
 
-}  // namespace app::study
+}  // namespace studies

@@ -2,7 +2,6 @@
 // each writing CSV tables, NAME.json and PNG charts into OUT/NAME/ (out/studies by default).
 // Here rather than in cli/ so that the tests run a study as the command does.
 #include <fmt/core.h>
-#include <omp.h>
 
 #include <functional>
 #include <map>
@@ -11,12 +10,13 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/timer.hpp"
+#include "pipeline/run_loop.hpp"
 
-namespace app::study {
+namespace studies {
 
 namespace {
 
-using StudyFunction = std::function<void(const PipelineScene&, bool, Output&)>;
+using StudyFunction = std::function<void(const scene::PipelineScene&, bool, Output&)>;
 
 const std::map<std::string, StudyFunction>& studies() {
   static const std::map<std::string, StudyFunction> table = {
@@ -45,7 +45,7 @@ int run_study(const StudyRequest& c) {
     for (const std::string& name : study_names()) known += (known.empty() ? "" : ", ") + name;
     throw diefill::InputError("", "NAME", fmt::format("there is no study \"{}\"", c.name), "Choose one of: " + known);
   }
-  PipelineScene scene = load_pipeline_scene(c.scene, c.overrides);
+  scene::PipelineScene scene = scene::load_pipeline_scene(c.scene, c.overrides);
   // The studies read fills and flows, not FEM decks or their runs' pictures: no hand-off, whose
   // mesh and CalculiX run would add seconds to each of their many runs, and no pictures (python,
   // about 1.5 s a run); the study draws its own charts.
@@ -53,7 +53,7 @@ int run_study(const StudyRequest& c) {
   scene.pictures = false;
   if (c.threads) scene.threads = *c.threads;
   if (c.seed) scene.seed = *c.seed;
-  if (scene.threads > 0) omp_set_num_threads(scene.threads);
+  const pipeline::ThreadCount threads(scene.threads);
   diefill::Stopwatch clock;
   Output out(c.out, c.name);
   try {
@@ -71,4 +71,4 @@ int run_study(const StudyRequest& c) {
   return 0;
 }
 
-}  // namespace app::study
+}  // namespace studies

@@ -26,7 +26,7 @@
 #include "mesh/import.hpp"
 #include "mesh/shapes.hpp"
 
-namespace app::study {
+namespace studies {
 
 namespace {
 
@@ -84,7 +84,7 @@ std::string run_problems(std::int64_t lost, double max_overlap, double max_energ
   return "";
 }
 
-std::string settled_result_problems(const dem::State& s, const LoopResult& run, double overlap_bound) {
+std::string settled_result_problems(const dem::State& s, const pipeline::LoopResult& run, double overlap_bound) {
   return run_problems(s.lost, run.max_overlap_rel, run.max_energy_gain, overlap_bound);
 }
 
@@ -131,7 +131,7 @@ std::string time_step_run(const Powder& powder, double fraction) {
   spec.time_step = fraction * std::min(bed.automatic.dt_rayleigh, bed.automatic.dt_hertz);
   const dem::Model model = dem::compile_model(spec, state, powder.source);
   dem::initialize(model, state);
-  const LoopResult run = advance(model, state, 0.15, fmt::format("stability: time step {:.3g} of the limit", fraction));
+  const pipeline::LoopResult run = advance(model, state, 0.15, fmt::format("stability: time step {:.3g} of the limit", fraction));
   return settled_result_problems(state, run, impact_overlap_bound(powder, fall_speed(powder, 20 * powder.diameter)));
 }
 
@@ -161,7 +161,7 @@ std::string voxel_run(const Powder& powder, double voxel_over_radius, const std:
   add_grains(state, region, powder, 600, powder.seed);
   const dem::Model model = dem::compile_model(spec, state, powder.source);
   dem::initialize(model, state);
-  const LoopResult run = advance(model, state, 0.12, fmt::format("stability: voxel {:.3g} grain radii", voxel_over_radius));
+  const pipeline::LoopResult run = advance(model, state, 0.12, fmt::format("stability: voxel {:.3g} grain radii", voxel_over_radius));
   // Judged by Embree's exact inside test on the die's solid, not by the wall field the contacts
   // used: a wrong sign that let a grain in would also say it is outside.
   const mesh::ExactSurface solid(die.solid);
@@ -186,18 +186,18 @@ std::string wall_speed_run(const Powder& powder, double step_over_half_skin) {
   spec.meshes = {block};
   const dem::Model model = dem::compile_model(spec, state, powder.source);
   dem::initialize(model, state);
-  const LoopResult run =
+  const pipeline::LoopResult run =
       advance(model, state, 8 * d / speed, fmt::format("stability: wall step {:.3g} of half the skin", step_over_half_skin));
   // A rigid wall pushing a bed: the bound the pipeline's shoe is designed to (half the stop limit).
   return settled_result_problems(state, run, 0.5 * spec.stop_overlap);
 }
 
-std::string coarse_cavity_run(const PipelineScene& scene, double diameter_over_width, const std::filesystem::path& work) {
+std::string coarse_cavity_run(const scene::PipelineScene& scene, double diameter_over_width, const std::filesystem::path& work) {
   // The ring's annulus is 5 mm wide.
-  PipelineScene s = scene;
+  scene::PipelineScene s = scene;
   s.coarse_graining = diameter_over_width * 5e-3 / s.particle_diameter;
   s.out = work / fmt::format("cavity_{:.3g}", diameter_over_width);
-  const DieRun run = run_die_fill(s, ring_mesh(work), false);
+  const pipeline::DieRun run = pipeline::run_die_fill(s, ring_mesh(work), false);
   const auto& particles = run.report["particles"];
   if (particles.value("in_cavity", 0) == 0) return "no grain entered the cavity";
   const auto& checked = run.report["stability"];
@@ -209,7 +209,7 @@ std::string coarse_cavity_run(const PipelineScene& scene, double diameter_over_w
 
 }  // namespace
 
-void stability(const PipelineScene& scene, bool reduced, Output& out) {
+void stability(const scene::PipelineScene& scene, bool reduced, Output& out) {
   const Powder powder = powder_of(scene);
   const std::filesystem::path work = out.work();
   const std::vector<double> time_steps = reduced ? std::vector<double>{0.15, 2.0} : std::vector<double>{0.1, 0.2, 0.4, 0.7, 1.0, 1.5, 2.5};
@@ -248,4 +248,4 @@ void stability(const PipelineScene& scene, bool reduced, Output& out) {
   out.results = {{"grain_diameter_m", powder.diameter}, {"probes", list}};
 }
 
-}  // namespace app::study
+}  // namespace studies

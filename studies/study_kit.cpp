@@ -10,16 +10,16 @@
 #include "mesh/sdf.hpp"
 #include "mesh/shapes.hpp"
 
-namespace app::study {
+namespace studies {
 
 namespace fs = std::filesystem;
 using dem::Vec3;
 
-Powder powder_of(const PipelineScene& scene) {
+Powder powder_of(const scene::PipelineScene& scene) {
   Powder p;
-  p.spec = coarse_grained_spec(scene.spec, scene.coarse_graining);
-  p.powder = material_named(scene.spec, "powder");
-  p.wall = material_named(scene.spec, "steel");
+  p.spec = scene::coarse_grained_spec(scene.spec, scene.coarse_graining);
+  p.powder = scene::material_named(scene.spec, "powder");
+  p.wall = scene::material_named(scene.spec, "steel");
   p.diameter = scene.grain_diameter();
   p.spread = scene.diameter_spread;
   p.density = scene.spec.materials[std::size_t(p.powder)].density;
@@ -56,10 +56,10 @@ std::size_t add_grains(dem::State& state, const dem::InsertRegion& region, const
   return dem::insert_spheres(state, region, request);
 }
 
-LoopResult advance(const dem::Model& model, dem::State& state, double until, const std::string& label, LoopOptions loop) {
+pipeline::LoopResult advance(const dem::Model& model, dem::State& state, double until, const std::string& label, pipeline::LoopOptions loop) {
   loop.until = until;
   loop.label = label;
-  LoopResult result = run_until(model, state, loop);
+  pipeline::LoopResult result = run_until(model, state, loop);
   if (result.interrupted) throw Interrupted{};
   return result;
 }
@@ -160,8 +160,8 @@ void Output::commit() {
   document["charts"] = charts_;
   const fs::path json = staging_ / (name_ + ".json");
   diefill::write_file_atomic(json, document.dump(2) + "\n");
-  draw_pictures({"study", json.string()});
+  pipeline::draw_pictures({"study", json.string()});
   staging_.commit();
 }
 
-}  // namespace app::study
+}  // namespace studies

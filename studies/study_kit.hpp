@@ -16,7 +16,7 @@
 #include "dem/model.hpp"
 #include "dem/state.hpp"
 
-namespace app::study {
+namespace studies {
 
 // Ctrl-C inside a study: nothing is written, the command exits 130.
 struct Interrupted {};
@@ -32,7 +32,7 @@ struct Powder {
   std::string source;        // the scene, for messages
   double r_max() const { return 0.5 * diameter * (1 + spread); }
 };
-Powder powder_of(const PipelineScene& scene);
+Powder powder_of(const scene::PipelineScene& scene);
 
 // An axis-aligned solid block [lo, hi] as a wall at rest.
 dem::MeshWall block_wall(const dem::Vec3& lo, const dem::Vec3& hi, double r_max, int material, const std::string& name);
@@ -48,7 +48,7 @@ std::size_t add_grains(dem::State& state, const dem::InsertRegion& region, const
 
 // Steps to `until` [s] with the label, outputs and early end of `loop`; throws Interrupted on
 // Ctrl-C and StabilityError on a failed check.
-LoopResult advance(const dem::Model& model, dem::State& state, double until, const std::string& label, LoopOptions loop = {});
+pipeline::LoopResult advance(const dem::Model& model, dem::State& state, double until, const std::string& label, pipeline::LoopOptions loop = {});
 
 // Forgets every grain-wall contact: for a scene whose walls change (a gate removed), so that no
 // history is carried over to a wall that now has another index.
@@ -118,4 +118,4 @@ class Output {
   nlohmann::json charts_ = nlohmann::json::array();
 };
 
-}  // namespace app::study
+}  // namespace studies

@@ -12,7 +12,7 @@
 #include "mesh/shapes.hpp"
 #include "mesh/tool.hpp"
 
-namespace app::study {
+namespace studies {
 
 using dem::Vec3;
 
@@ -144,7 +144,7 @@ SlotRun drain_bed(const Powder& p, const dem::ModelSpec& open_walls, const SlotC
   const double opened = run.state.time;
   const auto gone = [&](std::size_t i) { return !run.state.active[i] || run.state.x[i].z() < gone_below; };
   double quiet_since = opened;
-  LoopOptions sampling;
+  pipeline::LoopOptions sampling;
   sampling.outputs.push_back({c.sample_every, [&](const dem::State& s) {
                                 const double m = mass_where(s, gone);
                                 if (run.discharged.empty() || m > run.discharged.back()) quiet_since = s.time;
@@ -304,4 +304,4 @@ SurfaceFit fit_heap_surface(const dem::State& s, const Heap& h, double d) {
   return fit_surface(position, height);
 }
 
-}  // namespace app::study
+}  // namespace studies

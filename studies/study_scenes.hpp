@@ -11,7 +11,7 @@
 
 #include "studies/study_kit.hpp"
 
-namespace app::study {
+namespace studies {
 
 double grain_volume(double diameter);  // [m³] of a sphere
 // Height below which a fraction `q` of the active grains' centres lie [m].
@@ -100,4 +100,4 @@ OutflowAngle pooled(const std::vector<OutflowAngle>& beds);
 // Columns along the radius of the heap.
 SurfaceFit fit_heap_surface(const dem::State& state, const Heap& heap, double diameter);
 
-}  // namespace app::study
+}  // namespace studies

@@ -17,7 +17,7 @@
 namespace {
 
 namespace fs = std::filesystem;
-using app::study::MeasuredPowder;
+using studies::MeasuredPowder;
 
 // A lab's file that reads, broken one key at a time below.
 MeasuredPowder lab_powder() {
@@ -41,11 +41,11 @@ MeasuredPowder lab_powder() {
 // (docs/STUDIES.md, "calibration-round-trip": the default, four seeds a test, is 0.08 off on each).
 TEST(Calibrate, TheTrueFrictionsOfItsOwnTwinLieInsideTheReportedIntervals) {
   test::TempDir dir;
-  app::study::StudyRequest study;
+  studies::StudyRequest study;
   study.name = "calibration-round-trip";
   study.reduced = true;
   study.out = dir / "studies";
-  ASSERT_EQ(app::study::run_study(study), 0);
+  ASSERT_EQ(studies::run_study(study), 0);
   std::ifstream in(study.out / study.name / (study.name + ".json"));
   const nlohmann::json r = nlohmann::json::parse(in);
   for (const char* name : {"sliding_friction", "rolling_friction"})
@@ -54,22 +54,22 @@ TEST(Calibrate, TheTrueFrictionsOfItsOwnTwinLieInsideTheReportedIntervals) {
 
   // The block is ready to use: a scene of it loads with the fitted values and keeps the steel.
   const fs::path runs = study.out / study.name / "runs";
-  const app::PipelineScene calibrated = app::load_pipeline_scene(runs / "calibration" / "calibrated.toml", {});
-  const dem::Material& powder = calibrated.spec.materials[std::size_t(app::material_named(calibrated.spec, "powder"))];
+  const scene::PipelineScene calibrated = scene::load_pipeline_scene(runs / "calibration" / "calibrated.toml", {});
+  const dem::Material& powder = calibrated.spec.materials[std::size_t(scene::material_named(calibrated.spec, "powder"))];
   EXPECT_NEAR(powder.sliding_friction, r["sliding_friction"]["value"].get<double>(), 5e-4);
   EXPECT_NEAR(powder.rolling_friction, r["rolling_friction"]["value"].get<double>(), 5e-4);
-  EXPECT_NO_THROW(app::material_named(calibrated.spec, "steel"));
+  EXPECT_NO_THROW(scene::material_named(calibrated.spec, "steel"));
 
   // Resumed, the finished tests are kept: nothing runs again (the checkpoint does not grow) and
   // the result is the same.
-  app::study::CalibrateRequest c;
+  studies::CalibrateRequest c;
   c.measured = runs / "measured.toml";
   c.out = runs / "calibration";
   c.repeats = 1;
   c.resume = true;
   const auto tests_kept = fs::file_size(c.out / ".calibration_tests.jsonl");
   fs::remove(c.out / "calibration.json");
-  ASSERT_EQ(app::study::run_calibrate(c), 0);
+  ASSERT_EQ(studies::run_calibrate(c), 0);
   EXPECT_EQ(fs::file_size(c.out / ".calibration_tests.jsonl"), tests_kept);
   std::ifstream again(c.out / "calibration.json");
   EXPECT_EQ(nlohmann::json::parse(again)["sliding_friction"]["value"], r["sliding_friction"]["value"]);
@@ -77,8 +77,8 @@ TEST(Calibrate, TheTrueFrictionsOfItsOwnTwinLieInsideTheReportedIntervals) {
 
 TEST(Calibrate, MeasuredFileErrorsNameTheFileAndTheKey) {
   test::TempDir dir;
-  const std::string good = app::study::measured_powder_toml(lab_powder());
-  ASSERT_NO_THROW(app::study::read_measured_powder([&] {
+  const std::string good = studies::measured_powder_toml(lab_powder());
+  ASSERT_NO_THROW(studies::read_measured_powder([&] {
     test::write_text(dir / "m.toml", good);
     return dir / "m.toml";
   }()));
@@ -111,19 +111,19 @@ TEST(Examples, EachLoadsAndEachSceneRunsCoarsely) {
     if (entry.path().extension() != ".toml") continue;
     const test::Run shown = test::run_diefill("scene " + entry.path().string());
     EXPECT_EQ(shown.status, 0) << entry.path() << ": " << shown.output;
-    if (app::study::is_measured_powder(entry.path())) {
+    if (studies::is_measured_powder(entry.path())) {
       ++measured;
       continue;
     }
     test::TempDir dir;
-    app::PipelineScene s = app::load_pipeline_scene(entry.path(), {});
+    scene::PipelineScene s = scene::load_pipeline_scene(entry.path(), {});
     s.out = dir / "out";
     s.cache = dir / "cache";
     s.max_steps = 30;
     s.max_grains = std::min<std::size_t>(s.max_grains, 3000);
     s.fem_elements = "none";
     s.pictures = false;
-    EXPECT_NO_THROW(EXPECT_FALSE(app::run_die_fill(s, s.die, false).interrupted)) << entry.path();
+    EXPECT_NO_THROW(EXPECT_FALSE(pipeline::run_die_fill(s, s.die, false).interrupted)) << entry.path();
     ++scenes;
   }
   EXPECT_GE(scenes, 4);

@@ -60,7 +60,7 @@ dem::Model lattice_model(const dem::State& s, int materials) {
   for (int k = 0; k < materials; ++k) m[std::size_t(k)].rolling_friction = 0.1 + 0.05 * k;
   for (int k = 0; k < materials; ++k) m[std::size_t(k)].name = "glass " + std::to_string(k);
   dem::ModelSpec spec = test::spec_with(m);
-  spec.rolling = dem::RollingLaw::epsd;
+  spec.law.rolling = "epsd";
   spec.max_impact_speed = 0.5;
   return dem::compile_model(spec, s, "lattice");
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <string>
 
 #include "dem/contact.hpp"
 #include "dem_support.hpp"
@@ -17,13 +18,13 @@ struct Impact {
 };
 
 // Two equal spheres (or one sphere and a rigid plane) meet head on at relative speed v.
-Impact head_on(bool against_wall, double e, double v, dem::NormalLaw law = dem::NormalLaw::hertz,
+Impact head_on(bool against_wall, double e, double v, const std::string& law = "hertz",
                double step_fraction = 0.005) {
   const double r = 1e-3;
   dem::ModelSpec spec = test::spec_with({test::glass(e), test::rigid_wall(e)});
-  spec.normal = law;
+  spec.law.normal = law;
   spec.linear_stiffness = 2e4;
-  spec.tangential = dem::TangentialLaw::none;
+  spec.law.tangential = "none";
   spec.max_impact_speed = v;
   dem::State s;
   if (against_wall) {
@@ -88,7 +89,7 @@ TEST(Restitution, LinearLawGivesThePrescribedValue) {
   // The damping force sees the half-step velocity of velocity Verlet, an O(dt) lag: at 1/200
   // of the collision time e = 0.1 comes out 0.94 % low, at 1/1000 within 0.2 %.
   for (double e : {0.1, 0.3, 0.5, 0.7, 0.9}) {
-    const Impact got = head_on(true, e, 0.5, dem::NormalLaw::linear, 0.001);
+    const Impact got = head_on(true, e, 0.5, "linear", 0.001);
     EXPECT_NEAR(got.rebound_speed / 0.5, e, 0.005 * e) << "e = " << e;
   }
 }
@@ -99,7 +100,7 @@ TEST(Restitution, HertzLawGivesThePrescribedValue) {
     const double measured_wall = head_on(true, e, 0.5).rebound_speed / 0.5;
     // The common form β = ln e / sqrt(ln² e + π²) realises other values; reported for the record.
     const double beta = std::log(e) / std::sqrt(std::log(e) * std::log(e) + std::numbers::pi * std::numbers::pi);
-    const double common = dem::restitution_for_damping(dem::NormalLaw::hertz, -2 * std::sqrt(5.0 / 6.0) * beta);
+    const double common = dem::restitution_for_damping(dem::HertzNormal::unit_force, dem::HertzNormal::unit_damping, -2 * std::sqrt(5.0 / 6.0) * beta);
     std::printf("e = %.1f: measured %.4f (pair), %.4f (wall); the common damping form would give %.4f\n", e,
                 measured_pair, measured_wall, common);
     EXPECT_NEAR(measured_pair, e, 0.02 * e);
@@ -173,13 +174,13 @@ struct Floor {
 
 // The sphere resting on the floor at the overlap that carries its weight, moving at v and
 // spinning at w; both materials have restitution e, friction mu and rolling friction mu_r.
-Floor sphere_on_floor(dem::RollingLaw rolling, double e, double mu, double mu_r, const Vec3& v, const Vec3& w,
+Floor sphere_on_floor(const std::string& rolling, double e, double mu, double mu_r, const Vec3& v, const Vec3& w,
                       double step_fraction = 0.15) {
   dem::Material grain = test::glass(e, mu), wall = test::rigid_wall(e, mu);
   grain.rolling_friction = wall.rolling_friction = mu_r;
   dem::ModelSpec spec = test::spec_with({grain, wall}, Vec3(0, 0, -g));
   spec.planes.push_back({Vec3::Zero(), Vec3::UnitZ(), 1, "floor"});
-  spec.rolling = rolling;
+  spec.law.rolling = rolling;
   spec.time_step_fraction = step_fraction;
   Floor f{dem::Model{}, dem::State{}};
   f.s.add_sphere(0, Vec3(0, 0, grain_r - hertz_overlap(grain_m * g)), grain_r, grain_rho, 0, v, w);
@@ -218,7 +219,7 @@ double period_of(Step&& step, Signal&& signal, double dt, int crossings) {
 
 // Velocity of the sphere's centre after rolling freely from t1 to t2, decelerated by a rolling
 // torque μ_r R F_n: without slip, (m + I/R²) a = μ_r F_n, so a = (5/7) μ_r g.
-double rolling_deceleration(dem::RollingLaw law, double mu_r, double v0) {
+double rolling_deceleration(const std::string& law, double mu_r, double v0) {
   Floor f = sphere_on_floor(law, 0.5, 0.5, mu_r, Vec3(v0, 0, 0), Vec3(0, v0 / grain_r, 0));
   auto run_to = [&](double t) {
     while (f.s.time < t) {
@@ -235,7 +236,7 @@ double rolling_deceleration(dem::RollingLaw law, double mu_r, double v0) {
 
 TEST(Rolling, ConstantDirectionalTorqueDeceleratesARollingSphereAsTheClosedForm) {
   const double mu_r = 0.1;
-  const double ratio = rolling_deceleration(dem::RollingLaw::cdt, mu_r, 0.05) / (5.0 / 7.0 * mu_r * g);
+  const double ratio = rolling_deceleration("cdt", mu_r, 0.05) / (5.0 / 7.0 * mu_r * g);
   std::printf("CDT: deceleration / (5/7 mu_r g) = %.5f\n", ratio);
   EXPECT_NEAR(ratio, 1.0, 0.01);
 }
@@ -249,9 +250,9 @@ TEST(Rolling, ElasticPlasticSpringRocksAtItsStiffnessAndSlidesAtItsLimit) {
   const double rocking = std::sqrt(contact_modes(k_t, k_r, grain_r - overlap).first);
   // Amplitude a tenth of the limit: the spring's torque k_r θ stays below μ_r R F_n.
   const double w0 = 0.1 * (mu_r * grain_r * grain_m * g / k_r) * rocking;
-  Floor f = sphere_on_floor(dem::RollingLaw::epsd, 1.0, 0.5, mu_r, Vec3(w0 * grain_r, 0, 0), Vec3(0, w0, 0), 0.05);
+  Floor f = sphere_on_floor("epsd", 1.0, 0.5, mu_r, Vec3(w0 * grain_r, 0, 0), Vec3(0, w0, 0), 0.05);
   const double period = period_of([&] { dem::step(f.model, f.s); }, [&] { return -f.s.w[0].y(); }, f.model.dt, 10);
-  const double limit = rolling_deceleration(dem::RollingLaw::epsd, mu_r, 0.05) / (5.0 / 7.0 * mu_r * g);
+  const double limit = rolling_deceleration("epsd", mu_r, 0.05) / (5.0 / 7.0 * mu_r * g);
   std::printf("EPSD: rocking period / closed form = %.5f; deceleration at the limit / (5/7 mu_r g) = %.5f\n",
               period / (2 * std::numbers::pi / rocking), limit);
   EXPECT_NEAR(period / (2 * std::numbers::pi / rocking), 1.0, 0.01);
@@ -267,7 +268,7 @@ TEST(Friction, MindlinSpringSticksWithStiffnessEightGStarA) {
   const double omega = std::sqrt(contact_modes(k_t, 0, grain_r - overlap).second);
   // Sticking: the spring's force k_t v0/ω stays at a fifth of the Coulomb cap μ m g.
   const double v0 = 0.2 * mu * grain_m * g * omega / k_t;
-  Floor f = sphere_on_floor(dem::RollingLaw::none, 1.0, mu, 0, Vec3(v0, 0, 0), Vec3::Zero(), 0.01);
+  Floor f = sphere_on_floor("none", 1.0, mu, 0, Vec3(v0, 0, 0), Vec3::Zero(), 0.01);
   const double period = period_of([&] { dem::step(f.model, f.s); }, [&] { return -f.s.f[0].x(); }, f.model.dt, 10);
   const double measured_k_t = k_t * std::pow(2 * std::numbers::pi / period / omega, 2);
   std::printf("Mindlin: sticking stiffness / (8 G* a) = %.5f\n", measured_k_t / k_t);
@@ -283,7 +284,7 @@ Floor cohesive_sphere(double k, double g_up, double overlap) {
   grain.cohesion_energy_density = wall.cohesion_energy_density = k;
   dem::ModelSpec spec = test::spec_with({grain, wall}, Vec3(0, 0, g_up));
   spec.planes.push_back({Vec3::Zero(), Vec3::UnitZ(), 1, "floor"});
-  spec.cohesion = dem::CohesionLaw::sjkr;
+  spec.law.cohesion = "sjkr";
   Floor f{dem::Model{}, dem::State{}};
   f.s.add_sphere(0, Vec3(0, 0, grain_r - overlap), grain_r, grain_rho, 0);
   f.model = dem::compile_model(spec, f.s, "test");

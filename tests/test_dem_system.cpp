@@ -20,7 +20,7 @@ namespace {
 // Elastic, frictionless grains with random velocities in a box of planes.
 dem::ModelSpec gas_spec(bool walls) {
   dem::ModelSpec spec = test::spec_with({test::glass(1.0, 0.0), test::rigid_wall(1.0, 0.0)});
-  spec.tangential = dem::TangentialLaw::none;
+  spec.law.tangential = "none";
   spec.max_impact_speed = 1.0;
   spec.time_step_fraction = 0.02;
   spec.domain.lo = Vec3::Constant(-6e-3);
@@ -110,7 +110,7 @@ TEST(Reproducibility, ThreadCountDoesNotChangeTheState) {
     dem::ModelSpec with_gravity = spec;
     with_gravity.gravity = Vec3(0, 0, -9.81);
     with_gravity.materials[0].sliding_friction = 0.4;
-    with_gravity.tangential = dem::TangentialLaw::mindlin;
+    with_gravity.law.tangential = "mindlin";
     const dem::Model model = dem::compile_model(with_gravity, s, "gas");
     dem::initialize(model, s);
     for (int n = 0; n < 2000; ++n) dem::step(model, s);
@@ -132,7 +132,7 @@ TEST(Reproducibility, MeshWallsGiveTheSameStateOnAnyThreadCount) {
   const mesh::ToolMesh tool = mesh::tool_from_cavity(ring, mesh::table_around(ring, 3e-3), "ring");
   dem::ModelSpec spec = test::spec_with({test::glass(0.5, 0.4), test::rigid_wall(0.5, 0.3)}, Vec3(0, 0, -9.81));
   spec.materials[0].rolling_friction = spec.materials[1].rolling_friction = 0.1;
-  spec.rolling = dem::RollingLaw::epsd;
+  spec.law.rolling = "epsd";
   spec.meshes.push_back(dem::fixed_mesh_wall(test::wall_field_of(tool.mesh, r / 4), 1, "die"));
   dem::MeshWall plate = dem::fixed_mesh_wall(
       test::wall_field_of(mesh::box_solid(Vec3(-1e-3, -12e-3, 0.2e-3), Vec3(1e-3, 12e-3, 3.5e-3)), r / 4), 1, "plate");
@@ -172,7 +172,7 @@ TEST(Reproducibility, ResumedRunMatchesTheUninterruptedOne) {
   dem::ModelSpec spec = gas_spec(true);
   spec.gravity = Vec3(0, 0, -9.81);
   spec.materials[0].sliding_friction = 0.4;
-  spec.tangential = dem::TangentialLaw::mindlin;
+  spec.law.tangential = "mindlin";
   dem::State a = gas(300, 4, 0.3);
   const dem::Model model = dem::compile_model(spec, a, "gas");
   dem::initialize(model, a);

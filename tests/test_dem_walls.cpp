@@ -115,7 +115,7 @@ TEST_P(PourIntoDie, TenThousandGrainsSettleWithoutLeaking) {
   dem::ModelSpec spec = test::spec_with({test::glass(0.3, 0.5), test::rigid_wall(0.3, 0.5)}, Vec3(0, 0, -9.81));
   spec.materials[0].youngs_modulus = 5e6;
   spec.materials[0].rolling_friction = 0.1;
-  spec.rolling = dem::RollingLaw::epsd;
+  spec.law.rolling = "epsd";
   spec.max_impact_speed = 0.6;
   spec.domain.lo = Vec3(-14e-3, -14e-3, -12e-3);
   spec.domain.hi = Vec3(14e-3, 14e-3, 20e-3);
@@ -249,7 +249,7 @@ double pinched_pair_overlap(double cut_cap) {
   dem::Material steel = powder;
   steel.name = "steel", steel.youngs_modulus = 2.1e11, steel.sliding_friction = 0.3;
   dem::ModelSpec spec = test::spec_with({powder, steel}, Vec3(0, 0, -9.81));
-  spec.rolling = dem::RollingLaw::cdt;
+  spec.law.rolling = "cdt";
   spec.stop_overlap = 1.0;  // measured here, not stopped
   const double r_a = 0.45e-3, r_b = 0.5e-3, rim = 5e-3, speed = 0.4;
   spec.planes.push_back({Vec3::Zero(), Vec3::UnitZ(), 1, "table"});

@@ -158,7 +158,7 @@ namespace {
 // the cavity.
 struct RingFill {
   const mesh::PreparedDie& die;
-  app::DensityResult lattice;
+  pipeline::DensityResult lattice;
   std::vector<double> exact_cavity;  // [m³] per voxel, analytic
   double phi = std::numbers::pi / (3 * std::sqrt(2.0));
 };
@@ -192,9 +192,9 @@ const RingFill& ring_fill() {
   static const RingFill fill = [] {
     RingFill l{fine_ring(), {}, {}};
     const mesh::WallField walls = l.die.sdf.wall_field(l.die.solid);
-    app::DensitySettings s;
+    pipeline::DensitySettings s;
     s.voxel_m = 1e-3;
-    l.lattice = app::compute_density(ring_lattice(0.2e-3, Vec3(0.013e-3, 0.029e-3, 0.0)), l.die, walls, 7800, s, "lattice");
+    l.lattice = pipeline::compute_density(ring_lattice(0.2e-3, Vec3(0.013e-3, 0.029e-3, 0.0)), l.die, walls, 7800, s, "lattice");
     const post::VoxelGrid& g = l.lattice.field.grid;
     l.exact_cavity.resize(g.size());
     for (int i = 0; i < g.nx; ++i)
@@ -305,10 +305,10 @@ std::vector<post::Grain> ring_jittered_fill(double cell, double phi, std::uint64
 TEST(SmoothedField, KeepsAUniformFillFlatUpToTheWalls) {
   const double phi = 0.6;
   const mesh::WallField walls = fine_ring().sdf.wall_field(fine_ring().solid);
-  app::DensitySettings s;
+  pipeline::DensitySettings s;
   s.voxel_m = 2e-3;
   s.smoothed_width_m = 0.6e-3;
-  const app::DensityResult r = app::compute_density(ring_jittered_fill(0.125e-3, phi, 7), fine_ring(), walls, 7800, s, "uniform fill");
+  const pipeline::DensityResult r = pipeline::compute_density(ring_jittered_fill(0.125e-3, phi, 7), fine_ring(), walls, 7800, s, "uniform fill");
   ASSERT_TRUE(r.smoothed.has_value());
   std::size_t bins = 0;
   double worst = 0;
@@ -339,9 +339,9 @@ TEST(CavityVolume, NothingBelowAThinTableCountsAsCavity) {
   o.table = mesh::TableExtent{-15e-3, -15e-3, 15e-3, 15e-3, 2e-3};
   const mesh::PreparedDie die = mesh::prepare_die(test::source_dir() / "dies" / "ring.stl", o, std::nullopt);
   const mesh::WallField walls = die.sdf.wall_field(die.solid);
-  app::DensitySettings s;
+  pipeline::DensitySettings s;
   s.voxel_m = 3.2e-3;
-  const app::DensityResult r = app::compute_density({{Vec3(7.5e-3, 0, -5e-3), 0.8e-3, 1.0}}, die, walls, 7800, s, "one grain");
+  const pipeline::DensityResult r = pipeline::compute_density({{Vec3(7.5e-3, 0, -5e-3), 0.8e-3, 1.0}}, die, walls, 7800, s, "one grain");
   ASSERT_LT(r.field.grid.origin.z(), -12e-3) << "the grid must reach below the table for this test";
   const double exact = std::numbers::pi * (10e-3 * 10e-3 - 5e-3 * 5e-3) * 10e-3;
   EXPECT_NEAR(r.stats.cavity_volume_m3 / exact, 1.0, 0.01);

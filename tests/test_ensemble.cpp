@@ -67,7 +67,7 @@ TEST(EnsembleReport, VaryingFiguresGetTheirStandardErrorBesideThem) {
     return nlohmann::json{{"fill_ratio", fill}, {"voxel_m", 1.6e-3}, {"curve", curve},
                           {"profiles", {{"z", {{"solid_fraction", {p0, 0.4}}, {"position_m", {0.001, 0.002}}}}}}};
   };
-  const nlohmann::json m = app::mean_with_stderr({block(0.50, 0.1, "a.csv"), block(0.53, 0.2, "b.csv"), block(0.56, 0.3, "c.csv")});
+  const nlohmann::json m = pipeline::mean_with_stderr({block(0.50, 0.1, "a.csv"), block(0.53, 0.2, "b.csv"), block(0.56, 0.3, "c.csv")});
   EXPECT_NEAR(m["fill_ratio"].get<double>(), 0.53, 1e-15);
   EXPECT_NEAR(m["fill_ratio_stderr"].get<double>(), 0.03 / std::sqrt(3.0), 1e-15);
   EXPECT_EQ(m["voxel_m"].get<double>(), 1.6e-3);
@@ -83,10 +83,10 @@ TEST(EnsembleReport, VaryingFiguresGetTheirStandardErrorBesideThem) {
 // The fill curves' band: two seeds whose mass grows linearly at different rates give, sample by
 // sample, the mean mass and half their difference; the mean ends with the shorter curve.
 TEST(EnsembleCurve, BandIsHalfTheTwoSeedsDifference) {
-  std::vector<app::FillSample> a, b;
+  std::vector<pipeline::FillSample> a, b;
   for (int n = 0; n < 10; ++n) a.push_back({0.002 * n, 0.0, 10 * n, 1e-4 * n});
   for (int n = 0; n < 9; ++n) b.push_back({0.002 * n, 0.0, 12 * n, 1.4e-4 * n});
-  const auto [mean, band] = app::mean_curve({a, b});
+  const auto [mean, band] = pipeline::mean_curve({a, b});
   ASSERT_EQ(mean.size(), 9u);
   for (std::size_t n = 0; n < mean.size(); ++n) {
     EXPECT_NEAR(mean[n].mass, 1.2e-4 * double(n), 1e-18);
@@ -98,11 +98,11 @@ TEST(EnsembleCurve, BandIsHalfTheTwoSeedsDifference) {
 
 namespace {
 
-std::vector<app::LevelValue> affine_levels(double intercept, double slope, double curvature, const std::vector<double>& se,
+std::vector<pipeline::LevelValue> affine_levels(double intercept, double slope, double curvature, const std::vector<double>& se,
                                            std::mt19937_64* random) {
   const std::vector<double> diameters = {2.26e-3, 1.6e-3, 1.13e-3};
   std::normal_distribution<double> normal(0.0, 1.0);
-  std::vector<app::LevelValue> out;
+  std::vector<pipeline::LevelValue> out;
   for (std::size_t k = 0; k < diameters.size(); ++k) {
     const double d = diameters[k];
     out.push_back({d, intercept + slope * d + curvature * d * d + (random ? se[k] * normal(*random) : 0.0), se[k]});
@@ -114,7 +114,7 @@ std::vector<app::LevelValue> affine_levels(double intercept, double slope, doubl
 
 // A law the levels follow exactly is recovered to rounding, with χ² = 0.
 TEST(Extrapolation, RecoversAnExactAffineLaw) {
-  const app::AffineFit fit = app::fit_affine(affine_levels(0.60, -30, 0, {0.001, 0.002, 0.003}, nullptr));
+  const pipeline::AffineFit fit = pipeline::fit_affine(affine_levels(0.60, -30, 0, {0.001, 0.002, 0.003}, nullptr));
   EXPECT_NEAR(fit.intercept, 0.60, 1e-12);
   EXPECT_NEAR(fit.slope, -30, 1e-9);
   EXPECT_NEAR(fit.chi2, 0, 1e-18);
@@ -134,36 +134,36 @@ TEST(Extrapolation, StandardErrorIsTheEstimatesSpreadAndOnlyCurvatureIsRefused) 
   int refused = 0;
   const int ladders = 4000;
   for (int n = 0; n < ladders; ++n) {
-    const app::AffineFit fit = app::fit_affine(affine_levels(0.60, -30, 0, se, &random));
+    const pipeline::AffineFit fit = pipeline::fit_affine(affine_levels(0.60, -30, 0, se, &random));
     const double e = fit.at(target) - truth;
     sum += e, squares += e * e;
     claimed += fit.stderr_at(target) / std::sqrt(fit.birge) / ladders;
-    refused += !app::refuse_curved(fit).empty();
+    refused += !pipeline::refuse_curved(fit).empty();
   }
   const double spread = std::sqrt(squares / ladders - (sum / ladders) * (sum / ladders));
   EXPECT_NEAR(spread / claimed, 1.0, 0.05);
   EXPECT_LE(refused, int(0.025 * ladders));
-  EXPECT_NEAR(app::fit_affine(affine_levels(0.60, -30, 5e4, se, nullptr)).chi2, 24.58, 0.01);
+  EXPECT_NEAR(pipeline::fit_affine(affine_levels(0.60, -30, 5e4, se, nullptr)).chi2, 24.58, 0.01);
   int curved = 0;
-  for (int n = 0; n < 100; ++n) curved += !app::refuse_curved(app::fit_affine(affine_levels(0.60, -30, 5e4, se, &random))).empty();
+  for (int n = 0; n < 100; ++n) curved += !pipeline::refuse_curved(pipeline::fit_affine(affine_levels(0.60, -30, 5e4, se, &random))).empty();
   EXPECT_GE(curved, 95);
 }
 
 // χ²'s 99 % quantiles against the published table (Abramowitz and Stegun 26.4), the Wilson-Hilferty
 // approximation beyond ten degrees of freedom within 0.5 %.
 TEST(Extrapolation, ChiSquareQuantilesMatchTheTables) {
-  EXPECT_DOUBLE_EQ(app::chi2_quantile_99(1), 6.635);
-  EXPECT_DOUBLE_EQ(app::chi2_quantile_99(3), 11.345);
-  EXPECT_NEAR(app::chi2_quantile_99(15) / 30.578, 1.0, 0.005);
-  EXPECT_NEAR(app::chi2_quantile_99(20) / 37.566, 1.0, 0.005);
-  EXPECT_NEAR(app::chi2_quantile_99(30) / 50.892, 1.0, 0.005);
+  EXPECT_DOUBLE_EQ(pipeline::chi2_quantile_99(1), 6.635);
+  EXPECT_DOUBLE_EQ(pipeline::chi2_quantile_99(3), 11.345);
+  EXPECT_NEAR(pipeline::chi2_quantile_99(15) / 30.578, 1.0, 0.005);
+  EXPECT_NEAR(pipeline::chi2_quantile_99(20) / 37.566, 1.0, 0.005);
+  EXPECT_NEAR(pipeline::chi2_quantile_99(30) / 50.892, 1.0, 0.005);
 }
 
 // Pooled level errors: two levels whose seeds scatter as 1/√(grains) with one constant get their
 // own errors back; a level with few grains gets the larger error.
 TEST(Extrapolation, PooledErrorsScaleWithTheGrainsInTheCavity) {
   // Level 1: 3 seeds, 400 grains, se 0.003; level 2: 3 seeds, 1600 grains, se 0.0015 (half).
-  const std::vector<double> pooled = app::pooled_stderr({{3, 0.003, 400}, {3, 0.0015, 1600}});
+  const std::vector<double> pooled = pipeline::pooled_stderr({{3, 0.003, 400}, {3, 0.0015, 1600}});
   EXPECT_NEAR(pooled[0], 0.003, 1e-12);
   EXPECT_NEAR(pooled[1], 0.0015, 1e-12);
 }
@@ -184,18 +184,18 @@ TEST(Extrapolation, FeatureWidthsOfAnnulusSlotAndDisc) {
   EXPECT_NEAR(slot.narrowest()->width, 1.2e-3, 0.2e-3);
   const mesh::FeatureWidths disc = mesh::feature_widths(mesh::ring_cavity(20e-3, 0, 10e-3, 1e-6), 0.0, h);
   EXPECT_EQ(disc.share_below(19e-3), 0.0);
-  const app::Refusal r = app::refuse_thin_features(ring, 2.26e-3, 0.1e-3);
+  const pipeline::Refusal r = pipeline::refuse_thin_features(ring, 2.26e-3, 0.1e-3);
   EXPECT_NE(r.reason.find("5 mm wide"), std::string::npos) << r.reason;
   EXPECT_NEAR(r.alpha_needed, 10, 0.6);
-  EXPECT_TRUE(app::refuse_thin_features(disc, 2.26e-3, 0.1e-3).reason.empty());
+  EXPECT_TRUE(pipeline::refuse_thin_features(disc, 2.26e-3, 0.1e-3).reason.empty());
 }
 
 // `--budget`'s durations, and what is not one.
 TEST(Plan, DurationsParse) {
-  EXPECT_EQ(app::parse_duration("90"), 90);
-  EXPECT_EQ(app::parse_duration("90s"), 90);
-  EXPECT_EQ(app::parse_duration("30m"), 1800);
-  EXPECT_EQ(app::parse_duration("2h"), 7200);
-  EXPECT_EQ(app::parse_duration("1h30m"), 5400);
-  for (const char* bad : {"", "3 days", "h", "-5m", "0"}) EXPECT_THROW(app::parse_duration(bad), diefill::InputError) << bad;
+  EXPECT_EQ(pipeline::parse_duration("90"), 90);
+  EXPECT_EQ(pipeline::parse_duration("90s"), 90);
+  EXPECT_EQ(pipeline::parse_duration("30m"), 1800);
+  EXPECT_EQ(pipeline::parse_duration("2h"), 7200);
+  EXPECT_EQ(pipeline::parse_duration("1h30m"), 5400);
+  for (const char* bad : {"", "3 days", "h", "-5m", "0"}) EXPECT_THROW(pipeline::parse_duration(bad), diefill::InputError) << bad;
 }

@@ -48,7 +48,7 @@ dem::ModelSpec box_spec(bool gravity_and_walls) {
   dem::ModelSpec spec = test::spec_with({test::glass(0.5, 0.4), test::rigid_wall(0.5, 0.3)},
                                         gravity_and_walls ? Vec3(0, 0, -9.81) : Vec3::Zero());
   spec.materials[0].rolling_friction = spec.materials[1].rolling_friction = 0.1;
-  spec.rolling = dem::RollingLaw::epsd;
+  spec.law.rolling = "epsd";
   spec.max_impact_speed = 1.0;
   spec.domain.lo = Vec3::Constant(-8e-3);
   spec.domain.hi = Vec3::Constant(8e-3);
@@ -296,7 +296,7 @@ dem::ModelSpec ring_spec(double r) {
   const mesh::ToolMesh tool = mesh::tool_from_cavity(ring, mesh::table_around(ring, 3e-3), "ring");
   dem::ModelSpec spec = test::spec_with({test::glass(0.5, 0.4), test::rigid_wall(0.5, 0.3)}, Vec3(0, 0, -9.81));
   spec.materials[0].rolling_friction = spec.materials[1].rolling_friction = 0.1;
-  spec.rolling = dem::RollingLaw::epsd;
+  spec.law.rolling = "epsd";
   spec.max_impact_speed = 1.0;
   spec.domain = {Vec3(-14e-3, -14e-3, -12e-3), Vec3(14e-3, 14e-3, 16e-3)};
   spec.meshes.push_back(dem::fixed_mesh_wall(test::wall_field_of(tool.mesh, r / 2), 1, "ring"));

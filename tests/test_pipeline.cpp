@@ -65,10 +65,10 @@ const nlohmann::json& run(const std::string& die, double speed, std::uint64_t se
   // The FEM hand-off is tested on the plain runs; the variants leave it out (about 2 s each)
   // unless they ask for it.
   if (grains != coarse && grains.find("fem.elements") == std::string::npos) overrides.push_back("fem.elements=none");
-  app::PipelineScene scene = app::load_pipeline_scene(std::nullopt, overrides);
+  scene::PipelineScene scene = scene::load_pipeline_scene(std::nullopt, overrides);
   // Pictures are looked at on the plain runs only (python, a few seconds a run).
   scene.pictures = folder == "a" && grains == coarse;
-  const app::DieRun r = app::run_die_fill(scene, bundled_die(die), false);
+  const pipeline::DieRun r = pipeline::run_die_fill(scene, bundled_die(die), false);
   EXPECT_FALSE(r.interrupted);
   return done[key] = r.report;
 }
@@ -251,10 +251,10 @@ TEST(Pipeline, SmoothedFieldShowsTheWallLayerOfTheGrainCentres) {
       grains.push_back({s.x[i], s.radius[i], 1.0});
   const mesh::PreparedDie die = mesh::prepare_die(bundled_die("ring"), mesh::die_options_for_grains(d / 2, d / 4), std::nullopt);
   const mesh::WallField walls = die.sdf.wall_field(die.solid);
-  app::DensitySettings settings;
+  pipeline::DensitySettings settings;
   settings.voxel_m = 2 * d;
   settings.smoothed_width_m = width;
-  const app::DensityResult field = app::compute_density(grains, die, walls, 7800, settings, "ring");
+  const pipeline::DensityResult field = pipeline::compute_density(grains, die, walls, 7800, settings, "ring");
   ASSERT_TRUE(field.smoothed.has_value());
   // Voxels 3 widths clear of the floor and the table; the grain-centre profile from the grains
   // their kernels reach.
@@ -311,7 +311,7 @@ TEST(Pipeline, CompareGivesTheDifferenceOfTwoSeeds) {
   const nlohmann::json& one = run("ring", 0.1, 1, "a");
   const nlohmann::json& two = run("ring", 0.1, 2, "seed2");
   const fs::path out = suite_out() / "compare";
-  const nlohmann::json c = app::compare_runs(output_of("ring", "a"), output_of("ring", "seed2"), out);
+  const nlohmann::json c = pipeline::compare_runs(output_of("ring", "a"), output_of("ring", "seed2"), out);
   EXPECT_TRUE(c["same_scene"].get<bool>());
   EXPECT_EQ(c["seeds"], nlohmann::json({1, 2}));
   EXPECT_DOUBLE_EQ(c["fill"]["fill_ratio"]["difference"].get<double>(),
@@ -327,11 +327,11 @@ TEST(Pipeline, CompareGivesTheDifferenceOfTwoSeeds) {
   for (const auto& [index, value] : delta)
     EXPECT_NEAR(value, b.at("solid_fraction").values.at(index) - a.at("solid_fraction").values.at(index), 1e-6);
   EXPECT_TRUE(fs::exists(out / "compare.png"));
-  const nlohmann::json itself = app::compare_runs(output_of("ring", "a"), output_of("ring", "a"), suite_out() / "compare_itself");
+  const nlohmann::json itself = pipeline::compare_runs(output_of("ring", "a"), output_of("ring", "a"), suite_out() / "compare_itself");
   EXPECT_EQ(itself["field"]["largest_difference"].get<double>(), 0.0);
   EXPECT_EQ(itself["fill"]["fill_ratio"]["difference"].get<double>(), 0.0);
   run("disc", 0.1, 1);
-  EXPECT_THROW(app::compare_runs(output_of("ring"), output_of("disc"), suite_out() / "compare_dies"), diefill::InputError);
+  EXPECT_THROW(pipeline::compare_runs(output_of("ring"), output_of("disc"), suite_out() / "compare_dies"), diefill::InputError);
   EXPECT_FALSE(fs::exists(suite_out() / "compare_dies")) << "nothing written for a refused comparison";
 }
 
@@ -404,13 +404,13 @@ TEST(PipelineOwnRuns, SweepRunsEachCaseAsItsSingleRun) {
     std::vector<std::string> overrides = {"simulation.seed=1", "output.directory=" + base.string(), cache, "powder.coarse_graining=22.6",
                                           "motion.die_settle_time=0.01", "fem.elements=none"};
     overrides.insert(overrides.end(), more.begin(), more.end());
-    app::PipelineScene scene = app::load_pipeline_scene(std::nullopt, overrides);
+    scene::PipelineScene scene = scene::load_pipeline_scene(std::nullopt, overrides);
     scene.die = bundled_die("disc");
     scene.pictures = false;  // the sweep's own chart is drawn regardless
     return scene;
   };
-  const app::Sweep sweep = app::parse_sweep("motion.speed=0.1,0.2,0.4");
-  const std::vector<app::DieRun> runs = app::run_sweep(load, sweep, nullptr);
+  const pipeline::Sweep sweep = pipeline::parse_sweep("motion.speed=0.1,0.2,0.4");
+  const std::vector<pipeline::DieRun> runs = pipeline::run_sweep(load, sweep, nullptr);
   ASSERT_EQ(runs.size(), 3u);
   const double speeds[] = {0.1, 0.2, 0.4};
   for (std::size_t k = 0; k < 3; ++k) {
@@ -423,10 +423,10 @@ TEST(PipelineOwnRuns, SweepRunsEachCaseAsItsSingleRun) {
   const std::string table = read_text(base / "sweep_motion.speed.csv");
   EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 4) << table;
   EXPECT_TRUE(fs::exists(base / "sweep_motion.speed.png"));
-  EXPECT_THROW(app::parse_sweep("motion.speed"), diefill::InputError);
-  EXPECT_THROW(app::run_sweep(load, app::parse_sweep("output.directory=a,b"), nullptr), diefill::InputError);
+  EXPECT_THROW(pipeline::parse_sweep("motion.speed"), diefill::InputError);
+  EXPECT_THROW(pipeline::run_sweep(load, pipeline::parse_sweep("output.directory=a,b"), nullptr), diefill::InputError);
   // A bad last value is refused before the first case runs.
-  EXPECT_THROW(app::run_sweep(load, app::parse_sweep("powder.coarse_graining=16,-1"), nullptr), diefill::InputError);
+  EXPECT_THROW(pipeline::run_sweep(load, pipeline::parse_sweep("powder.coarse_graining=16,-1"), nullptr), diefill::InputError);
   EXPECT_FALSE(fs::exists(base / "powder.coarse_graining=16")) << "no case ran";
 }
 
@@ -573,10 +573,10 @@ TEST(PipelineOwnRuns, ClumpGrainsFillTheRingWithoutLeaking) {
 TEST(PipelineOwnRuns, MeshThatCrashedCorefinementIsRefusedClearly) {
   REQUIRE_SHARED_MESHES();
   for (const auto& [up, message] : {std::pair{"+z", "no flat top face"}, std::pair{"auto", "no flat face at its extreme"}}) {
-    app::PipelineScene scene = app::load_pipeline_scene(
+    scene::PipelineScene scene = scene::load_pipeline_scene(
         std::nullopt, {"powder.max_grains=3000", std::string("die.up=") + up, "die.parting=opening", "output.directory=" + (suite_out() / "refused").string()});
     try {
-      app::run_die_fill(scene, test::shared_meshes() / "dies" / "broken" / "assimp_3DSMaxExport.stl", false);
+      pipeline::run_die_fill(scene, test::shared_meshes() / "dies" / "broken" / "assimp_3DSMaxExport.stl", false);
       ADD_FAILURE() << "the mesh was accepted";
     } catch (const diefill::InputError& e) {
       EXPECT_NE(std::string(e.what()).find("assimp_3DSMaxExport.stl"), std::string::npos) << e.what();

@@ -23,7 +23,7 @@ namespace {
 // when it loads.
 std::string refusal_of(const std::optional<std::filesystem::path>& scene, const std::vector<std::string>& overrides) {
   try {
-    app::load_pipeline_scene(scene, overrides);
+    scene::load_pipeline_scene(scene, overrides);
     return "";
   } catch (const diefill::InputError& e) {
     return e.what();
@@ -33,43 +33,43 @@ std::string refusal(const std::string& override_text) { return refusal_of(std::n
 
 // A value just outside a range, below or above (a whole number for an integer key); for a range
 // that allows 0 besides its interval, the gap between them and a negative value too.
-std::vector<double> outside(const app::ValueRange& r, app::KeyType type) {
-  if (type == app::KeyType::integer) return {r.lo - 1, r.hi + 1};
+std::vector<double> outside(const scene::ValueRange& r, scene::KeyType type) {
+  if (type == scene::KeyType::integer) return {r.lo - 1, r.hi + 1};
   const double below = r.lo_open ? r.lo : r.lo - std::max(1.0, std::abs(r.lo)) * 1e-3;
   const double above = r.hi_open ? r.hi : r.hi + std::max(1.0, std::abs(r.hi)) * 1e-3;
   if (r.or_zero) return {0.5 * r.lo, -r.lo, above};
   return {below, above};
 }
 
-std::string toml_number(double x, app::KeyType type) {
-  return type == app::KeyType::integer ? fmt::format("{}", std::llround(x)) : fmt::format("{:e}", x);
+std::string toml_number(double x, scene::KeyType type) {
+  return type == scene::KeyType::integer ? fmt::format("{}", std::llround(x)) : fmt::format("{:e}", x);
 }
 
 }  // namespace
 
 TEST(SceneKeys, EveryNumberOutsideItsRangeIsRefusedNamingTheKey) {
   int checked = 0;
-  for (const auto& key : app::pipeline_keys()) {
-    if (key.type != app::KeyType::number && key.type != app::KeyType::integer && key.type != app::KeyType::number_or_auto &&
-        key.type != app::KeyType::vec3)
+  for (const auto& key : scene::pipeline_keys()) {
+    if (key.type != scene::KeyType::number && key.type != scene::KeyType::integer && key.type != scene::KeyType::number_or_auto &&
+        key.type != scene::KeyType::vec3)
       continue;
     for (double x : outside(key.range, key.type)) {
-      const std::string value = key.type == app::KeyType::vec3 ? fmt::format("[0, 0, {:e}]", x) : toml_number(x, key.type);
+      const std::string value = key.type == scene::KeyType::vec3 ? fmt::format("[0, 0, {:e}]", x) : toml_number(x, key.type);
       const std::string why = refusal(key.path() + "=" + value);
       EXPECT_NE(why.find(key.path()), std::string::npos) << key.path() << " = " << value << ": " << why;
       ++checked;
     }
     EXPECT_FALSE(key.meaning.empty()) << key.path() << " is undocumented";
   }
-  for (const auto& key : app::material_keys()) {
-    if (key.type != app::KeyType::number) continue;
+  for (const auto& key : scene::material_keys()) {
+    if (key.type != scene::KeyType::number) continue;
     for (double x : outside(key.range, key.type)) {
       // Materials are an array of tables: a scene file gives them.
       test::TempDir dir;
       test::write_text(dir / "scene.toml", fmt::format("[[materials]]\nname = \"powder\"\n{} = {:e}\n\n[[materials]]\nname = \"steel\"\n",
                                                       key.name, x));
       try {
-        app::load_pipeline_scene(dir / "scene.toml", {});
+        scene::load_pipeline_scene(dir / "scene.toml", {});
         ADD_FAILURE() << key.name << " = " << x << " loaded";
       } catch (const diefill::InputError& e) {
         EXPECT_NE(std::string(e.what()).find("materials[0]." + std::string(key.name)), std::string::npos) << e.what();
@@ -101,16 +101,16 @@ TEST(SceneKeys, AbsurdValuesFoundByTheReviewAreRefusedByName) {
 TEST(SceneMaterials, AnEntryNamedLikeADefaultChangesOnlyItsKeys) {
   test::TempDir dir;
   test::write_text(dir / "scene.toml", "[[materials]]\nname = \"powder\"\nrolling_friction = 0.2\n");
-  const app::PipelineScene defaults;
-  const app::PipelineScene s = app::load_pipeline_scene(dir / "scene.toml", {});
+  const scene::PipelineScene defaults;
+  const scene::PipelineScene s = scene::load_pipeline_scene(dir / "scene.toml", {});
   ASSERT_EQ(s.spec.materials.size(), defaults.spec.materials.size());
-  const dem::Material& powder = s.spec.materials[std::size_t(app::material_named(s.spec, "powder"))];
-  const dem::Material& default_powder = defaults.spec.materials[std::size_t(app::material_named(defaults.spec, "powder"))];
+  const dem::Material& powder = s.spec.materials[std::size_t(scene::material_named(s.spec, "powder"))];
+  const dem::Material& default_powder = defaults.spec.materials[std::size_t(scene::material_named(defaults.spec, "powder"))];
   EXPECT_EQ(powder.rolling_friction, 0.2);
   EXPECT_EQ(powder.sliding_friction, default_powder.sliding_friction);
   EXPECT_EQ(powder.density, default_powder.density);
-  EXPECT_EQ(s.spec.materials[std::size_t(app::material_named(s.spec, "steel"))].youngs_modulus,
-            defaults.spec.materials[std::size_t(app::material_named(defaults.spec, "steel"))].youngs_modulus);
+  EXPECT_EQ(s.spec.materials[std::size_t(scene::material_named(s.spec, "steel"))].youngs_modulus,
+            defaults.spec.materials[std::size_t(scene::material_named(defaults.spec, "steel"))].youngs_modulus);
 
   const test::Run shown = test::run_diefill("scene " + (dir / "scene.toml").string());
   ASSERT_EQ(shown.status, 0) << shown.output;
@@ -119,7 +119,7 @@ TEST(SceneMaterials, AnEntryNamedLikeADefaultChangesOnlyItsKeys) {
 
   // A new name adds a material; the same name twice is refused, naming the entry.
   test::write_text(dir / "scene.toml", "[[materials]]\nname = \"brass\"\ndensity = 8500\n");
-  EXPECT_EQ(app::load_pipeline_scene(dir / "scene.toml", {}).spec.materials.size(), defaults.spec.materials.size() + 1);
+  EXPECT_EQ(scene::load_pipeline_scene(dir / "scene.toml", {}).spec.materials.size(), defaults.spec.materials.size() + 1);
   test::write_text(dir / "scene.toml", "[[materials]]\nname = \"powder\"\n\n[[materials]]\nname = \"powder\"\n");
   EXPECT_NE(refusal_of(dir / "scene.toml", {}).find("materials[1].name"), std::string::npos);
 }
@@ -129,7 +129,7 @@ namespace {
 // Random mutations of the fully resolved default scene: one to three lines each given a value
 // from a list of troublemakers, or cut short.
 std::vector<std::string> mutated_scenes(int count, std::uint64_t seed) {
-  const std::string base = app::describe(app::PipelineScene{});
+  const std::string base = scene::describe(scene::PipelineScene{});
   std::vector<std::string> lines;
   std::stringstream in(base);
   for (std::string line; std::getline(in, line);) lines.push_back(line);
@@ -162,9 +162,9 @@ TEST(SceneKeys, MutatedScenesLoadOrAreRefusedClearly) {
   for (const std::string& text : mutated_scenes(300, 2026)) {
     test::write_text(dir / "scene.toml", text);
     try {
-      const app::PipelineScene s = app::load_pipeline_scene(dir / "scene.toml", {});
-      for (const auto& key : app::pipeline_keys()) {
-        if (key.type == app::KeyType::number || key.type == app::KeyType::integer) {
+      const scene::PipelineScene s = scene::load_pipeline_scene(dir / "scene.toml", {});
+      for (const auto& key : scene::pipeline_keys()) {
+        if (key.type == scene::KeyType::number || key.type == scene::KeyType::integer) {
           EXPECT_TRUE(key.range.contains(std::get<double>(key.get(s)))) << key.path() << " in\n" << text;
         }
       }
@@ -188,9 +188,9 @@ TEST(SceneKeys, MutatedScenesThatLoadRunOrStopClearly) {
   int completed = 0, refused = 0, stopped = 0;
   for (const std::string& text : mutated_scenes(100, 44)) {
     test::write_text(dir / "scene.toml", text);
-    app::PipelineScene s;
+    scene::PipelineScene s;
     try {
-      s = app::load_pipeline_scene(dir / "scene.toml", {});
+      s = scene::load_pipeline_scene(dir / "scene.toml", {});
     } catch (const diefill::InputError&) {
       continue;
     }
@@ -202,7 +202,7 @@ TEST(SceneKeys, MutatedScenesThatLoadRunOrStopClearly) {
     s.fem_compaction = "none";
     s.pictures = false;
     try {
-      const app::DieRun run = app::run_die_fill(s, s.die, false);
+      const pipeline::DieRun run = pipeline::run_die_fill(s, s.die, false);
       EXPECT_FALSE(run.interrupted);
       ++completed;
     } catch (const diefill::InputError&) {
@@ -218,23 +218,23 @@ TEST(SceneKeys, MutatedScenesThatLoadRunOrStopClearly) {
 // The settled shoe is reused only while everything that shaped it is unchanged: the settling
 // keys and the DEM's code; the shoe's motion after settling does not count.
 TEST(SettledShoe, KeyFollowsTheSettlingKeysAndTheDemCode) {
-  const app::PipelineScene scene;
-  const app::SettledShoeInputs inputs{"die", {0.8e-3, 0.44e-3, 8, 1000}, {}, 0, 0};
-  const std::string key = app::settled_shoe_key(scene, inputs, "dem-code-a");
-  EXPECT_EQ(app::settled_shoe_key(scene, inputs, "dem-code-a"), key);
-  EXPECT_NE(app::settled_shoe_key(scene, inputs, "dem-code-b"), key) << "changed DEM sources";
-  app::PipelineScene other = scene;
+  const scene::PipelineScene scene;
+  const pipeline::SettledShoeInputs inputs{"die", {0.8e-3, 0.44e-3, 8, 1000}, {}, 0, 0};
+  const std::string key = pipeline::settled_shoe_key(scene, inputs, "dem-code-a");
+  EXPECT_EQ(pipeline::settled_shoe_key(scene, inputs, "dem-code-a"), key);
+  EXPECT_NE(pipeline::settled_shoe_key(scene, inputs, "dem-code-b"), key) << "changed DEM sources";
+  scene::PipelineScene other = scene;
   other.shoe_settle_time *= 1.5;
-  EXPECT_NE(app::settled_shoe_key(other, inputs, "dem-code-a"), key) << "a settling key";
+  EXPECT_NE(pipeline::settled_shoe_key(other, inputs, "dem-code-a"), key) << "a settling key";
   other = scene;
   other.spec.materials[0].sliding_friction = 0.45;
-  EXPECT_NE(app::settled_shoe_key(other, inputs, "dem-code-a"), key) << "a material";
+  EXPECT_NE(pipeline::settled_shoe_key(other, inputs, "dem-code-a"), key) << "a material";
   other = scene;
   other.speed = 0.3;
   other.die_settle_time = 0.2;
   other.density_voxel = 1e-3;
   other.threads = 2;
-  EXPECT_EQ(app::settled_shoe_key(other, inputs, "dem-code-a"), key) << "keys that act after the shoe has settled";
+  EXPECT_EQ(pipeline::settled_shoe_key(other, inputs, "dem-code-a"), key) << "keys that act after the shoe has settled";
 }
 
 // docs/INTERFACE.md's key reference is the table's own, so the two cannot drift apart.
@@ -244,7 +244,7 @@ TEST(SceneKeys, InterfaceDocumentListsEveryKeyAsTheTableHasIt) {
   const std::size_t from = doc.find(begin), to = doc.find("<!-- end of generated keys -->");
   ASSERT_NE(from, std::string::npos);
   ASSERT_NE(to, std::string::npos);
-  EXPECT_EQ(doc.substr(from + begin.size(), to - from - begin.size()), app::scene_keys_markdown())
+  EXPECT_EQ(doc.substr(from + begin.size(), to - from - begin.size()), scene::scene_keys_markdown())
       << "regenerate the section with `diefill scene --keys`";
 }
 
@@ -263,10 +263,10 @@ TEST(Census, SortsGrainsThatLeftByTheFaceTheyCrossedAndCountsTheMissing) {
   add(dem::Vec3(0, 51e-3, 1e-3), false);    // over the table's side
   add(dem::Vec3(-51e-3, 0, 1e-3), false);   // over its end
   add(dem::Vec3(0, 0, 41e-3), false);       // out through the top
-  app::ShoePlan shoe;
+  pipeline::ShoePlan shoe;
   shoe.length = 20e-3, shoe.width = 20e-3;
   const dem::Box3 domain{dem::Vec3(-50e-3, -50e-3, -20e-3), dem::Vec3(50e-3, 50e-3, 40e-3)};
-  const app::Census c = app::count_grains(s, 7, 0.0, shoe, domain);  // one inserted grain is missing
+  const pipeline::Census c = pipeline::count_grains(s, 7, 0.0, shoe, domain);  // one inserted grain is missing
   EXPECT_EQ(c.inserted, 7u);
   EXPECT_EQ(c.grains, 6u);
   EXPECT_EQ(c.in_cavity, 1u);

@@ -43,11 +43,11 @@ TEST_P(SharpFeatureDie, FillsWithNoGrainInsideTheDieSolid) {
   fs::create_directories(dir);
   const mesh::TriMesh cavity = mesh::bundled_die(d.name);
   mesh::write_stl(cavity, dir / (std::string(d.name) + ".stl"), mesh::LengthUnit::mm, std::string("diefill ") + d.name + " cavity, mm");
-  app::PipelineScene scene = app::load_pipeline_scene(
+  scene::PipelineScene scene = scene::load_pipeline_scene(
       std::nullopt, {fmt::format("powder.coarse_graining={}", d.coarse_graining), "output.snapshot_every=0.05",
                      "output.directory=" + (dir / "out").string()});
   scene.pictures = false;  // nothing here looks at them
-  const app::DieRun run = app::run_die_fill(scene, dir / (std::string(d.name) + ".stl"), false);
+  const pipeline::DieRun run = pipeline::run_die_fill(scene, dir / (std::string(d.name) + ".stl"), false);
   ASSERT_FALSE(run.interrupted);
   // No grain left through the die: the run stops with an error naming it (pipeline/census.cpp).
   // A grain the trailing wall strikes off may still roll over the simulated table's edge beside

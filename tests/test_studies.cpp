@@ -22,12 +22,12 @@ namespace fs = std::filesystem;
 nlohmann::json run_study(const std::string& name, bool reduced, std::vector<std::string> overrides) {
   const fs::path out = fs::temp_directory_path() / fmt::format("diefill-study-{}-{}", name, ::getpid());
   fs::remove_all(out);
-  app::study::StudyRequest c;
+  studies::StudyRequest c;
   c.name = name;
   c.reduced = reduced;
   c.out = out;
   c.overrides = std::move(overrides);
-  EXPECT_EQ(app::study::run_study(c), 0);
+  EXPECT_EQ(studies::run_study(c), 0);
   std::ifstream in(out / name / (name + ".json"));
   return nlohmann::json::parse(in);
 }
