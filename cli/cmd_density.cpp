@@ -13,10 +13,9 @@
 namespace cli {
 
 int run_density(const DensityCommand& c) {
-  mesh::DieOptions options = mesh::die_options_for_grains(0.5e-3, 0.25e-3);
-  options.unit = mesh::parse_unit(c.units, "--units");
-  options.role = mesh::parse_role(c.role, "--role");
-  if (options.role == mesh::WallRole::tool)
+  const std::optional<mesh::LengthUnit> unit = mesh::parse_unit_or_auto(c.units, "--units");
+  const mesh::WallRole role = mesh::parse_role(c.role, "--role");
+  if (role == mesh::WallRole::tool)
     throw diefill::InputError(c.die.string(), "--role", "a density field needs the cavity, not the tool body",
                               "Give the cavity mesh (role cavity) or a container");
   const dem::State particles = dem::read_particles(c.particles, 0, c.material_density);
@@ -35,9 +34,11 @@ int run_density(const DensityCommand& c) {
   // of the die's field; contacts are not computed here, so half a grain radius (not a quarter:
   // 8 times fewer voxels to build) seeds the queries.
   mesh::DieOptions sized = mesh::die_options_for_grains(r_max, 0.5 * r_max, 0.5 * r_max);
-  sized.unit = options.unit;
-  sized.role = options.role;
-  const mesh::PreparedDie die = mesh::prepare_die(c.die, sized, std::nullopt);
+  sized.role = role;
+  // Read as `diefill sdf` and `run` read a die: in the unit given, else in the one its size suggests.
+  const mesh::DieFile file = mesh::read_die_file(c.die, unit, mesh::up_to_read(sized), mesh::parting_to_read(sized));
+  sized.unit = file.unit;
+  const mesh::PreparedDie die = mesh::prepare_die(file, sized, std::nullopt);
   const mesh::WallField walls = die.sdf.wall_field(die.solid);
   pipeline::DensitySettings s;
   s.voxel_m = c.voxel_mm > 0 ? c.voxel_mm * 1e-3 : 4 * r_max;

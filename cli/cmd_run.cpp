@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cctype>
-#include <set>
 #include <string_view>
 
 #include "cli/commands.hpp"
@@ -14,6 +13,7 @@
 #include "pipeline/compare.hpp"
 #include "pipeline/die_fill.hpp"
 #include "pipeline/ensemble.hpp"
+#include "pipeline/folder_run.hpp"
 #include "pipeline/ladder.hpp"
 #include "pipeline/run_plan.hpp"
 #include "pipeline/preflight.hpp"
@@ -22,7 +22,6 @@
 #include "studies/measured_powder.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
-#include "core/log.hpp"
 
 namespace cli {
 
@@ -44,26 +43,6 @@ void apply_command_line(scene::PipelineScene& scene, const RunCommand& c) {
   if (c.up) scene.die_up = *c.up;
   if (c.units) scene.die_units = *c.units;
   scene.force = c.force;
-}
-
-// The mesh formats a CAD tool writes and assimp reads; anything else in the folder (a README, a
-// log, a scene) is not a die and is passed over, with a note.
-bool is_mesh(const fs::path& p) {
-  static const std::set<std::string> formats = {".stl", ".obj", ".ply", ".off", ".3ds", ".fbx", ".dae", ".gltf", ".glb", ".3mf", ".amf"};
-  std::string extension = p.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return formats.count(extension) > 0;
-}
-
-std::vector<fs::path> meshes_in(const fs::path& folder) {
-  std::vector<fs::path> files, others;
-  for (const auto& entry : fs::directory_iterator(folder))
-    if (entry.is_regular_file()) (is_mesh(entry.path()) ? files : others).push_back(entry.path());
-  std::sort(files.begin(), files.end());
-  for (const fs::path& other : others) diefill::log::info("{}: not a mesh file; passed over", other.string());
-  if (files.empty())
-    throw diefill::InputError(folder.string(), "", "the folder holds no mesh files", "Put die meshes (STL, OBJ, PLY, ...) into it");
-  return files;
 }
 
 // A word as the shell reads it back: quoted unless it is plain.
@@ -168,6 +147,40 @@ int run_grain_ladder(const RunCommand& c, const std::shared_ptr<dem::Exchange>& 
                           ranks);
 }
 
+int run_swept(const RunCommand& c, const std::shared_ptr<dem::Exchange>& ranks) {
+  const bool root = !ranks || ranks->rank() == 0;
+  if (fs::is_directory(c.target))
+    throw diefill::InputError(c.target.string(), "--sweep", "sweeps one die, not a folder", "Give a die mesh or a scene");
+  if (c.resume)
+    throw diefill::InputError("--sweep", "--resume", "a sweep does not resume", "Resume the interrupted case with `diefill run` and its --set");
+  const auto load = [&](const std::vector<std::string>& more) { return command_scene(c, more); };
+  const std::vector<pipeline::DieRun> runs = pipeline::run_sweep(load, pipeline::parse_sweep(*c.sweep), ranks);
+  if (!runs.empty() && runs.back().interrupted) return diefill::exit_interrupted;
+  if (root)
+    fmt::print("sweep: {} runs; summary {}\n", runs.size(),
+               (runs.front().dir.parent_path().parent_path() / ("sweep_" + pipeline::parse_sweep(*c.sweep).key + ".csv")).string());
+  return 0;
+}
+
+int run_one_die(const RunCommand& c, const std::shared_ptr<dem::Exchange>& ranks) {
+  const bool root = !ranks || ranks->rank() == 0;
+  const scene::PipelineScene scene = command_scene(c, {});
+  if (scene.die.empty())
+    throw diefill::InputError(c.target.string(), "die.file", "names no die", "Give [die] file = \"...\" or run a mesh");
+  const pipeline::DieRun run = pipeline::run_die_fill(scene, scene.die, c.resume, ranks);
+  if (run.interrupted) {
+    if (!root) return diefill::exit_interrupted;
+    if (fs::exists(run.dir / "checkpoint.bin"))
+      fmt::print(stderr, "interrupted; resume with `{}`{}\n", resume_command(c, scene.out),
+                 ranks ? " under the same mpirun" : "");
+    else
+      fmt::print(stderr, "interrupted before the shoe moved: no checkpoint to resume from; rerun the command to start again\n");
+    return diefill::exit_interrupted;
+  }
+  if (root) fmt::print("{}: report {}\n", run.die, (run.dir / "report.json").string());
+  return pipeline::stop_requested() ? diefill::exit_interrupted : 0;
+}
+
 }  // namespace
 
 int run_plan(const PlanCommand& c) {
@@ -210,84 +223,16 @@ int run_pipeline(const RunCommand& c) {
   pipeline::install_interrupt_handler();
   // Under mpirun every rank runs this; rank 0 reports (pipeline/die_fill.hpp).
   const std::shared_ptr<dem::Exchange> ranks = mpi_exchange();
-  const bool root = !ranks || ranks->rank() == 0;
   if (c.plan) return run_planned(c);
   if (c.ladder) return run_grain_ladder(c, ranks);
   if (c.extrapolate_to) throw diefill::InputError("--extrapolate-to", "", "extrapolates a ladder", "Give --ladder A1,A2,A3 with it");
   if (c.seeds && *c.seeds != 1) return run_seed_ensemble(c, ranks);
-  if (c.sweep) {
-    if (fs::is_directory(c.target))
-      throw diefill::InputError(c.target.string(), "--sweep", "sweeps one die, not a folder", "Give a die mesh or a scene");
-    if (c.resume)
-      throw diefill::InputError("--sweep", "--resume", "a sweep does not resume", "Resume the interrupted case with `diefill run` and its --set");
-    const auto load = [&](const std::vector<std::string>& more) { return command_scene(c, more); };
-    const std::vector<pipeline::DieRun> runs = pipeline::run_sweep(load, pipeline::parse_sweep(*c.sweep), ranks);
-    if (!runs.empty() && runs.back().interrupted) return diefill::exit_interrupted;
-    if (root)
-      fmt::print("sweep: {} runs; summary {}\n", runs.size(),
-                 (runs.front().dir.parent_path().parent_path() / ("sweep_" + pipeline::parse_sweep(*c.sweep).key + ".csv")).string());
-    return 0;
-  }
-  if (!fs::is_directory(c.target)) {
-    const scene::PipelineScene scene = command_scene(c, {});
-    if (scene.die.empty())
-      throw diefill::InputError(c.target.string(), "die.file", "names no die", "Give [die] file = \"...\" or run a mesh");
-    const pipeline::DieRun run = pipeline::run_die_fill(scene, scene.die, c.resume, ranks);
-    if (run.interrupted) {
-      if (!root) return diefill::exit_interrupted;
-      if (fs::exists(run.dir / "checkpoint.bin"))
-        fmt::print(stderr, "interrupted; resume with `{}`{}\n", resume_command(c, scene.out),
-                   ranks ? " under the same mpirun" : "");
-      else
-        fmt::print(stderr, "interrupted before the shoe moved: no checkpoint to resume from; rerun the command to start again\n");
-      return diefill::exit_interrupted;
-    }
-    if (root) fmt::print("{}: report {}\n", run.die, (run.dir / "report.json").string());
-    return pipeline::stop_requested() ? diefill::exit_interrupted : 0;
-  }
+  if (c.sweep) return run_swept(c, ranks);
+  if (!fs::is_directory(c.target)) return run_one_die(c, ranks);
   // A folder: every mesh into its own folder, then a summary table.
   RunCommand folder = c;
   folder.target.clear();  // the folder holds dies, not a scene
-  const scene::PipelineScene scene = command_scene(folder, {});
-  std::string csv = "die,status,grains_in_cavity,fill_ratio,solid_fraction_mean,solid_fraction_std,solid_fraction_min,solid_fraction_max,message\n";
-  std::string md = "| die | status | grains in cavity | fill ratio | mean | std | min | max |\n|---|---|---|---|---|---|---|---|\n";
-  int refused = 0, unstable = 0;
-  const auto record_failure = [&](const fs::path& mesh, const char* status, std::string message) {
-    if (root) fmt::print(stderr, "error: {}\n", message);
-    std::replace(message.begin(), message.end(), ',', ';');
-    std::replace(message.begin(), message.end(), '|', '/');
-    csv += fmt::format("{},{},,,,,,,{}\n", mesh.stem().string(), status, message);
-    md += fmt::format("| {} | {}: {} | | | | | | |\n", mesh.stem().string(), status, message);
-  };
-  for (const fs::path& mesh : meshes_in(c.target)) {
-    try {
-      const pipeline::DieRun run = pipeline::run_die_fill(scene, mesh, c.resume, ranks);
-      // Stopped while its outputs were written (the FEM hand-off): that die is done, no other starts.
-      if (run.interrupted || pipeline::stop_requested()) return diefill::exit_interrupted;
-      if (!root) continue;
-      const auto& fill = run.report["fill"];
-      const auto value = [&](const char* key) { return fill.value(key, 0.0); };
-      csv += fmt::format("{},ok,{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},\n", run.die, run.report["particles"]["in_cavity"].get<std::size_t>(),
-                         value("fill_ratio"), value("solid_fraction_mean"), value("solid_fraction_std"),
-                         value("solid_fraction_min"), value("solid_fraction_max"));
-      md += fmt::format("| {} | ok | {} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} |\n", run.die,
-                        run.report["particles"]["in_cavity"].get<std::size_t>(), value("fill_ratio"),
-                        value("solid_fraction_mean"), value("solid_fraction_std"), value("solid_fraction_min"),
-                        value("solid_fraction_max"));
-    } catch (const diefill::InputError& e) {
-      ++refused;
-      record_failure(mesh, "refused", e.what());
-    } catch (const diefill::StabilityError& e) {
-      ++unstable;  // the next die may still run; its checkpoint stays for a resume
-      record_failure(mesh, "stopped", e.what());
-    }
-  }
-  if (root) {
-    diefill::write_file_atomic(scene.out / "summary.csv", csv);
-    diefill::write_file_atomic(scene.out / "summary.md", md);
-    fmt::print("{}", md);
-  }
-  return unstable > 0 ? diefill::exit_unstable : refused > 0 ? diefill::exit_bad_input : diefill::exit_ok;
+  return pipeline::run_folder(command_scene(folder, {}), c.target, c.resume, ranks);
 }
 
 int run_compare(const CompareCommand& c) {

@@ -99,7 +99,7 @@ struct DensityCommand {
   std::filesystem::path particles;  // CSV or VTU
   std::filesystem::path die;
   std::filesystem::path output;
-  std::string units = "mm";
+  std::string units = "auto";  // as sdf and run read a die
   std::string role = "cavity";
   double voxel_mm = 0;        // 0: four grain radii
   std::string method = "exact";

@@ -8,15 +8,29 @@
 #include "studies/calibrate.hpp"
 #include "studies/studies.hpp"
 #include "core/error.hpp"
+#include "core/length.hpp"
 #include "core/log.hpp"
 
 namespace {
+
+// A length flag: a bare number is millimetres, as its help says; a number with its unit is
+// converted (core/length.hpp; docs/INTERFACE.md, "Lengths").
+CLI::Option* in_mm(CLI::Option* option) {
+  return option->transform(CLI::Validator(
+      [](std::string& text) {
+        if (const std::optional<diefill::Length> length = diefill::parse_length(text)) text = fmt::format("{}", length->millimetres());
+        else if (!diefill::parse_length(text + "mm"))
+          return "\"" + text + "\" is not a length: give millimetres, or a number with its unit (0.2mm, 2e-4m, 200um, 0.01in)";
+        return std::string();
+      },
+      "", "length"));
+}
 
 void add_sdf(CLI::App& root, cli::SdfCommand& c, std::function<int()>& action) {
   CLI::App* cmd = root.add_subcommand("sdf", "Check and repair a mesh, then write its signed-distance grid");
   cmd->add_option("MESH", c.mesh, "Mesh file (STL, OBJ, PLY, OFF, ...)")->required();
   cmd->add_option("-o,--out", c.output, "Output .vdb file");
-  cmd->add_option("--voxel", c.voxel_mm, "Voxel edge [mm] (default: a quarter of the grain radius)");
+  in_mm(cmd->add_option("--voxel", c.voxel_mm, "Voxel edge [mm] (default: a quarter of the grain radius)"));
   cmd->add_option("--units", c.units, "Length unit of the file: mm, m, in, or auto (guessed from its size)")
       ->capture_default_str();
   cmd->add_option("--up", c.up, "The way a cavity's opening faces in the file: +x, -x, +y, -y, +z, -z, or auto (found)")
@@ -31,11 +45,11 @@ void add_sdf(CLI::App& root, cli::SdfCommand& c, std::function<int()>& action) {
       ->capture_default_str();
   cmd->add_option("--role", c.role, "cavity (the part, open at the table), tool (the die body) or container (a closed vessel)")
       ->capture_default_str();
-  cmd->add_option("--grain-radius", c.grain_radius_mm, "Largest grain radius [mm]")->capture_default_str();
-  cmd->add_option("--skin", c.skin_mm, "Neighbour skin [mm]")->capture_default_str();
-  cmd->add_option("--tolerance", c.tolerance_mm, "Largest change repair may make [mm] (default: half a voxel)");
-  cmd->add_option("--max-hole", c.max_hole_mm, "Largest hole repair fills [mm] (default: 10 voxels)");
-  cmd->add_option("--table-margin", c.table_margin_mm, "Die table beyond the cavity [mm]")->capture_default_str();
+  in_mm(cmd->add_option("--grain-radius", c.grain_radius_mm, "Largest grain radius [mm]"))->capture_default_str();
+  in_mm(cmd->add_option("--skin", c.skin_mm, "Neighbour skin [mm]"))->capture_default_str();
+  in_mm(cmd->add_option("--tolerance", c.tolerance_mm, "Largest change repair may make [mm] (default: half a voxel)"));
+  in_mm(cmd->add_option("--max-hole", c.max_hole_mm, "Largest hole repair fills [mm] (default: 10 voxels)"));
+  in_mm(cmd->add_option("--table-margin", c.table_margin_mm, "Die table beyond the cavity [mm]"))->capture_default_str();
   cmd->add_option("--verify", c.verify, "Compare N points in the band with the exact distance");
   cmd->add_option("--seed", c.seed, "Seed of the verification points")->capture_default_str();
   cmd->callback([&] { action = [&] { return cli::run_sdf(c); }; });
@@ -120,14 +134,15 @@ void add_density(CLI::App& root, cli::DensityCommand& c, std::function<int()>& a
   cmd->add_option("PARTICLES", c.particles, "Particles CSV or VTU snapshot")->required();
   cmd->add_option("--die", c.die, "The die's cavity mesh")->required();
   cmd->add_option("-o,--out", c.output, "Output folder")->required();
-  cmd->add_option("--units", c.units, "Length unit of the die mesh")->capture_default_str();
+  cmd->add_option("--units", c.units, "Length unit of the die mesh: mm, m, in, or auto (guessed from its size)")
+      ->capture_default_str();
   cmd->add_option("--role", c.role, "cavity or container")->capture_default_str();
-  cmd->add_option("--voxel", c.voxel_mm, "Voxel edge [mm] (default: four grain radii)");
+  in_mm(cmd->add_option("--voxel", c.voxel_mm, "Voxel edge [mm] (default: four grain radii)"));
   cmd->add_option("--method", c.method, "exact (volume split exactly) or gaussian (kernel)")->capture_default_str();
-  cmd->add_option("--width", c.width_mm, "Gaussian width [mm] (default: one voxel)");
-  cmd->add_option("--smoothed-width", c.smoothed_width_mm,
+  in_mm(cmd->add_option("--width", c.width_mm, "Gaussian width [mm] (default: one voxel)"));
+  in_mm(cmd->add_option("--smoothed-width", c.smoothed_width_mm,
                   "Width [mm] of the smoothed field written beside the main one (Gaussian, on voxels as wide; default "
-                  "half the largest grain diameter)");
+                  "half the largest grain diameter)"));
   cmd->add_option("--material-density", c.material_density, "Grain material density [kg/m³] (default: from the file)");
   cmd->add_option("--coarse-graining", c.coarse_graining,
                   "The file's grains over the real powder's size, recorded in the field (1: they are the powder)")
@@ -135,7 +150,7 @@ void add_density(CLI::App& root, cli::DensityCommand& c, std::function<int()>& a
       ->check(CLI::Range(1.0, 1e4));
   cmd->add_flag("--fem", c.fem, "Also the FEM hand-off in OUTPUT/fem/: tetrahedral mesh with the fill per element (fill.inp, fill.vtu) "
                                 "and the CalculiX compaction example");
-  cmd->add_option("--element-size", c.element_size_mm, "The tetrahedra's largest edge [mm] (default: the voxel)");
+  in_mm(cmd->add_option("--element-size", c.element_size_mm, "The tetrahedra's largest edge [mm] (default: the voxel)"));
   cmd->add_option("--elements", c.elements, "linear (C3D4) or quadratic (C3D10)")
       ->capture_default_str()
       ->check(CLI::IsMember({"linear", "quadratic"}));
@@ -213,6 +228,8 @@ int main(int argc, char** argv) {
   CLI::App root{"diefill: simulate how a powder fills a press die"};
   root.set_version_flag("--version", [] { return cli::version_text(); });
   root.require_subcommand(1);
+  root.footer("Lengths: a bare number is millimetres on the command line and metres in a scene; either takes a unit: "
+              "0.2mm, 2e-4m, 200um, 0.01in.");
   bool verbose = false;
   root.add_flag("-v,--verbose", verbose, "Log each stage with its time");
   root.parse_complete_callback([&] {

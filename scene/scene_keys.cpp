@@ -47,15 +47,17 @@ std::string toml_value(const KeyValue& value, KeyType type) {
   return fmt::format("[{}, {}, {}]", v.x(), v.y(), v.z());
 }
 
-std::optional<KeyValue> read_value(Table& t, std::string_view name, KeyType type, const std::filesystem::path& base) {
+std::optional<KeyValue> read_value(Table& t, std::string_view name, KeyType type, std::string_view unit,
+                                   const std::filesystem::path& base) {
   const std::string key(name);
+  const bool length = unit == "m";
   switch (type) {
     case KeyType::number:
-      if (auto x = t.number(key)) return *x;
+      if (auto x = length ? t.length(key) : t.number(key)) return *x;
       return std::nullopt;
     case KeyType::number_or_auto: {
       bool automatic = false;
-      const std::optional<double> x = t.number_or(key, "auto", automatic);
+      const std::optional<double> x = length ? t.length_or(key, "auto", automatic) : t.number_or(key, "auto", automatic);
       if (automatic) return std::numeric_limits<double>::quiet_NaN();
       if (x) return *x;
       return std::nullopt;

@@ -80,7 +80,9 @@ std::string toml_value(const KeyValue& value, KeyType type);
 void check_value(Table& where, std::string_view name, KeyType type, const ValueRange& range,
                  const std::vector<std::string_view>& choices, const KeyValue& value, std::string_view unit);
 // Reads one value of the given type from `t` (nullopt when absent); wrong types fail.
-std::optional<KeyValue> read_value(Table& t, std::string_view name, KeyType type, const std::filesystem::path& base);
+// A number whose unit is "m" is a length: it may also be written with its unit ("0.2 mm").
+std::optional<KeyValue> read_value(Table& t, std::string_view name, KeyType type, std::string_view unit,
+                                   const std::filesystem::path& base);
 std::string_view type_name(KeyType type);
 std::string_view shapes_name(Shapes shapes);
 
@@ -90,7 +92,7 @@ void read_table_keys(Table& t, std::string_view table_path, const KeyTable<Targe
                      const std::filesystem::path& base) {
   for (const SceneKey<Target>& key : keys) {
     if (key.table != table_path) continue;
-    const std::optional<KeyValue> value = read_value(t, key.name, key.type, base);
+    const std::optional<KeyValue> value = read_value(t, key.name, key.type, key.unit, base);
     if (!value) continue;
     check_value(t, key.name, key.type, key.range, key.choices, *value, key.unit);
     key.set(target, *value);

@@ -6,6 +6,7 @@
 #include <toml++/toml.h>
 
 #include "core/error.hpp"
+#include "core/length.hpp"
 
 namespace scene {
 
@@ -121,6 +122,27 @@ std::optional<double> Table::number_or(const std::string& key, const std::string
       return std::nullopt;
     }
     fail(key, "must be a number or \"" + word + "\"", "Give seconds or \"" + word + "\"");
+  }
+  return number(key);
+}
+
+std::optional<double> Table::length(const std::string& key) {
+  bool never = false;
+  return length_or(key, "", never);
+}
+
+std::optional<double> Table::length_or(const std::string& key, const std::string& word, bool& is_word) {
+  const auto* n = static_cast<const toml::node*>(find(key));
+  is_word = false;
+  if (!n) return std::nullopt;
+  if (auto s = n->value<std::string>()) {
+    if (!word.empty() && *s == word) {
+      is_word = true;
+      return std::nullopt;
+    }
+    if (const std::optional<diefill::Length> l = diefill::parse_length(*s)) return l->metres();
+    fail(key, fmt::format("must be a length: metres, or a number with its unit{}, not \"{}\"", word.empty() ? "" : " or \"" + word + "\"", *s),
+         "Write for example 0.0002 or \"0.2 mm\" (units m, mm, um, in)");
   }
   return number(key);
 }

@@ -28,6 +28,10 @@ class Table {
   bool has(const std::string& key) const;
   // A number or a string (time_step = "auto").
   std::optional<double> number_or(const std::string& key, const std::string& word, bool& is_word);
+  // A length [m]: a number of metres or a string with its unit, "0.2 mm" (core/length.hpp); with
+  // `word`, that word too (skin = "auto").
+  std::optional<double> length(const std::string& key);
+  std::optional<double> length_or(const std::string& key, const std::string& word, bool& is_word);
 
   std::optional<Table> table(const std::string& key);
   std::vector<Table> tables(const std::string& key);  // array of tables

@@ -11,7 +11,8 @@ namespace {
 
 // A number that must lie in [lo, hi]: absent or outside, the error names the table and the key.
 double bounded(scene::Table& t, const std::string& key, double lo, double hi, const char* unit, std::optional<double> fallback = {}) {
-  const std::optional<double> v = t.number(key);
+  // A length may carry its unit ("2.5 mm"), as in scenes.
+  const std::optional<double> v = std::string_view(unit) == "m" ? t.length(key) : t.number(key);
   if (!v && fallback) return *fallback;
   if (!v) t.fail(key, "is missing", fmt::format("Give it in {} (between {:g} and {:g})", unit, lo, hi));
   if (*v < lo || *v > hi) t.fail(key, fmt::format("is {:g}, outside [{:g}, {:g}] {}", *v, lo, hi, unit), "Give it in SI units");

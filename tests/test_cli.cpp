@@ -86,6 +86,26 @@ TEST(Cli, SdfRejectsBadMeshesClearly) {
   expect_bad_input("sdf --voxel -1 " + d + "/ring.stl", "voxel", "positive");
 }
 
+// A length flag takes its unit: the same voxel written as 0.5, 0.5mm or 500um gives the same grid
+// (its voxel, band and active voxels as `sdf` reports them); a unit it does not know is bad input
+// naming the flag.
+TEST(Cli, LengthFlagsTakeAUnit) {
+  test::TempDir dir;
+  mesh::write_stl(mesh::bundled_die("disc"), dir / "disc.stl", mesh::LengthUnit::mm, "disc");
+  const auto grid_line = [&](const std::string& voxel) {
+    const test::Run run = test::run_diefill("sdf " + (dir / "disc.stl").string() + " --voxel " + voxel + " -o " + (dir / "d.vdb").string());
+    EXPECT_EQ(run.status, 0) << run.output;
+    const std::size_t at = run.output.find("sdf: role");
+    return at == std::string::npos ? std::string() : run.output.substr(at, run.output.find('\n', at) - at);
+  };
+  const std::string bare = grid_line("0.5");
+  ASSERT_NE(bare.find("voxel 0.5 mm"), std::string::npos) << bare;
+  EXPECT_EQ(grid_line("0.5mm"), bare);
+  EXPECT_EQ(grid_line("500um"), bare);
+  expect_bad_input("sdf " + (dir / "disc.stl").string() + " --voxel 0.5furlong -o " + (dir / "x.vdb").string(), "--voxel",
+                   "not a length");
+}
+
 TEST(Cli, FailedSdfKeepsTheEarlierOutput) {
   test::TempDir dir;
   mesh::write_stl(mesh::bundled_die("disc"), dir / "disc.stl", mesh::LengthUnit::mm, "disc");

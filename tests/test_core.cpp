@@ -11,6 +11,7 @@
 #include "core/timer.hpp"
 #include "core/base64.hpp"
 #include "core/error.hpp"
+#include "core/length.hpp"
 #include "core/sha256.hpp"
 #include "support.hpp"
 
@@ -118,4 +119,18 @@ TEST(ChildProcess, ReturnsTheBytesReportsACrashAndStopsOnRequest) {
   EXPECT_EQ(stopped.outcome, diefill::ChildOutcome::stopped);
   EXPECT_TRUE(stopped.bytes.empty());
   EXPECT_LT(clock.seconds(), 10.0);
+}
+
+// Lengths typed with their unit: each unit's factor exact, spaces allowed, anything else refused.
+TEST(Length, ReadsANumberWithItsUnitAndRefusesTheRest) {
+  const auto mm_of = [](const char* text) { return diefill::parse_length(text).value().millimetres(); };
+  EXPECT_EQ(mm_of("0.2mm"), 0.2);
+  EXPECT_EQ(mm_of(" 0.2 mm "), 0.2);
+  EXPECT_EQ(mm_of("2e-4m"), 0.2);
+  EXPECT_EQ(mm_of("200um"), 200e-3);
+  EXPECT_EQ(mm_of("200µm"), 200e-3);
+  EXPECT_EQ(mm_of("1in"), 25.4);
+  EXPECT_EQ(diefill::parse_length("40mm")->metres(), 40 * 1e-3);
+  for (const char* bad : {"0.2", "mm", "0.2 furlong", "0.2mmm", "nan mm", "inf m", ""})
+    EXPECT_FALSE(diefill::parse_length(bad).has_value()) << bad;
 }

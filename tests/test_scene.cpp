@@ -237,6 +237,22 @@ TEST(SettledShoe, KeyFollowsTheSettlingKeysAndTheDemCode) {
   EXPECT_EQ(pipeline::settled_shoe_key(other, inputs, "dem-code-a"), key) << "keys that act after the shoe has settled";
 }
 
+// A length key takes metres or a length with its unit, from --set as from a file; a unit it does
+// not know is refused naming the key.
+TEST(SceneKeys, ALengthKeyTakesItsUnit) {
+  const scene::PipelineScene metres = scene::load_pipeline_scene(std::nullopt, {"shoe.length=0.04"});
+  // 40 x 1e-3 is the double nearest 0.04 or its neighbour: the unit's factor is one rounding.
+  EXPECT_DOUBLE_EQ(scene::load_pipeline_scene(std::nullopt, {"shoe.length=40mm"}).shoe_length, metres.shoe_length);
+  EXPECT_DOUBLE_EQ(scene::load_pipeline_scene(std::nullopt, {"shoe.length=\"40 mm\""}).shoe_length, metres.shoe_length);
+  EXPECT_EQ(scene::load_pipeline_scene(std::nullopt, {"simulation.skin=50um"}).spec.skin.value_or(0), 50 * 1e-6);
+  try {
+    scene::load_pipeline_scene(std::nullopt, {"shoe.length=40furlongs"});
+    ADD_FAILURE() << "an unknown unit was accepted";
+  } catch (const diefill::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("length"), std::string::npos) << e.what();
+  }
+}
+
 // docs/INTERFACE.md's key reference is the table's own, so the two cannot drift apart.
 TEST(SceneKeys, InterfaceDocumentListsEveryKeyAsTheTableHasIt) {
   const std::string doc = test::read_text(test::source_dir() / "docs" / "INTERFACE.md");
