@@ -52,7 +52,7 @@ LengthUnit parse_unit(std::string_view text, std::string_view field);
 // As parse_unit, and "auto": no unit given, to be guessed from the mesh's size (guess_unit).
 std::optional<LengthUnit> parse_unit_or_auto(std::string_view text, std::string_view field);
 // The unit a file most likely uses, from its largest extent in the file's own numbers: a die or
-// a part is 3 mm to a metre or two across (README, "Units"). 3 or more reads as mm; 1 to 3 as
+// a part is 3 mm to a metre or two across (docs/MESHES.md, "Units"). 3 or more reads as mm; 1 to 3 as
 // inches (25-76 mm: a part a few inches across); less than 1 as metres (a part under a metre).
 LengthUnit guess_unit(double extent_in_file_units);
 
