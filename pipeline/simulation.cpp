@@ -10,6 +10,7 @@
 #include "core/log.hpp"
 #include "dem/distributed.hpp"
 #include "dem/io.hpp"
+#include "mesh/die.hpp"
 #include "pipeline/run_loop.hpp"
 
 namespace pipeline {
@@ -36,11 +37,28 @@ nlohmann::json summary_json(const dem::Model& model, const dem::State& state, co
           {"stability", {{"max_overlap_rel", result.max_overlap_rel}, {"max_energy_gain", result.max_energy_gain}}}};
 }
 
+// The scene's mesh walls, their fields built here: loading the scene builds nothing heavy.
+void add_mesh_walls(scene::SimulationScene& scene) {
+  double r_max = 0;
+  for (double r : scene.state.radius) r_max = std::max(r_max, r);
+  for (const scene::MeshWallEntry& w : scene.mesh_walls) {
+    mesh::DieOptions options = mesh::die_options_for_grains(r_max, scene.spec.skin.value_or(0.5 * r_max));
+    options.unit = mesh::parse_unit(w.units, w.name + ".units");
+    options.role = mesh::parse_role(w.role, w.name + ".role");
+    const mesh::PreparedDie die = mesh::prepare_die(w.file, options, std::nullopt);
+    dem::MeshWall wall =
+        dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid)), w.material, w.name);
+    if (w.motion) wall.motion = *w.motion;
+    scene.spec.meshes.push_back(wall);
+  }
+}
+
 }  // namespace
 
 int simulate(scene::SimulationScene scene, bool resume, const std::shared_ptr<dem::Exchange>& ranks) {
   const ThreadCount threads(scene.threads);
   const fs::path dir = scene.output.directory;
+  add_mesh_walls(scene);
   fs::create_directories(dir);
   const dem::Model model = dem::compile_model(scene.spec, scene.state, scene.source);
   const std::size_t grains = scene.state.size();

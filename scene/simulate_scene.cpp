@@ -6,7 +6,6 @@
 
 #include "core/error.hpp"
 #include "dem/io.hpp"
-#include "mesh/die.hpp"
 #include "scene/physics_keys.hpp"
 #include "scene/toml_reader.hpp"
 
@@ -168,8 +167,6 @@ dem::Box3 default_domain(const dem::State& state) {
 }
 
 void read_walls(Table& root, SimulationScene& scene, const std::vector<std::string>& names, const fs::path& base) {
-  double r_max = 0;
-  for (double r : scene.state.radius) r_max = std::max(r_max, r);
   for (Table& w : root.tables("walls")) {
     WallEntry entry;
     entry.material = names.front();
@@ -183,14 +180,7 @@ void read_walls(Table& root, SimulationScene& scene, const std::vector<std::stri
       continue;
     }
     if (entry.file.empty()) w.fail("file", "is missing", "Name the wall's mesh");
-    mesh::DieOptions options = mesh::die_options_for_grains(r_max, scene.spec.skin.value_or(0.5 * r_max));
-    options.unit = mesh::parse_unit(entry.units, w.path() + ".units");
-    options.role = mesh::parse_role(entry.role, w.path() + ".role");
-    const mesh::PreparedDie die = mesh::prepare_die(entry.file, options, std::nullopt);
-    dem::MeshWall wall = dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid)), material,
-                                              w.path());
-    if (motion) wall.motion = *motion;
-    scene.spec.meshes.push_back(wall);
+    scene.mesh_walls.push_back({w.path(), entry.file, entry.units, entry.role, material, motion});
   }
 }
 

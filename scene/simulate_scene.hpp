@@ -19,6 +19,16 @@ struct OutputSettings {
   double snapshot_every = 0;       // [s]; 0: none
 };
 
+// A [[walls]] mesh as the scene names it: its distance field is built by the simulation
+// (pipeline/simulation.cpp), so that loading a scene builds nothing heavy.
+struct MeshWallEntry {
+  std::string name;  // the table's path (walls[k]), for messages and as the wall's name
+  std::filesystem::path file;
+  std::string units, role;  // choices the loader checked: mm, m or in; cavity, tool or container
+  int material = 0;
+  std::optional<dem::Motion> motion;
+};
+
 struct SimulationScene {
   std::string source;
   dem::ModelSpec spec;
@@ -27,6 +37,7 @@ struct SimulationScene {
   int threads = 0;         // 0: all cores
   std::uint64_t seed = 1;
   OutputSettings output;
+  std::vector<MeshWallEntry> mesh_walls;  // in the order of [[walls]]; spec.meshes is empty until they are built
 };
 
 SimulationScene load_simulation_scene(const std::filesystem::path& path, const std::vector<std::string>& overrides);
