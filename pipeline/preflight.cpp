@@ -16,7 +16,7 @@ namespace {
 // Two grains, the smallest and the largest the size distribution draws: the model's time step is
 // the smallest Rayleigh and collision time over its grains, and its skin follows the largest.
 dem::Model compile_on_stand_ins(const dem::ModelSpec& spec, double diameter, double spread, const std::string& source) {
-  const int powder = scene::material_named(spec, "powder");
+  const int powder = scene::powder_material(spec);
   dem::State stand_ins;
   const double density = spec.materials[std::size_t(powder)].density;
   stand_ins.add_sphere(0, dem::Vec3::Zero(), 0.5 * diameter * (1 - spread), density, powder);

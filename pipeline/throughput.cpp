@@ -45,7 +45,7 @@ nlohmann::json read_json(const fs::path& file) {
 // the particle-steps per second of 300.
 double measure_kernel(const scene::PipelineScene& s, const GrainSizing& grains) {
   dem::ModelSpec spec = scene::coarse_grained_spec(s.spec, grains.alpha);
-  const int powder = scene::material_named(spec, "powder"), steel = scene::material_named(spec, "steel");
+  const int powder = scene::powder_material(spec), steel = scene::tool_material(spec);
   const double d = grains.diameter, half = 10 * d;
   spec.planes = {{dem::Vec3::Zero(), dem::Vec3::UnitZ(), steel, "floor"},
                  {dem::Vec3(-half, 0, 0), dem::Vec3::UnitX(), steel, "x-"}, {dem::Vec3(half, 0, 0), -dem::Vec3::UnitX(), steel, "x+"},

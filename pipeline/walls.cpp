@@ -112,8 +112,8 @@ double largest_inscribed_radius_bound(const mesh::WallField& die, const mesh::Tr
 
 FillWalls prepare_walls(const scene::PipelineScene& s, const DieSource& source, const GrainSizing& grains, const ShoePlan& shoe) {
   FillWalls w;
-  w.powder = scene::material_named(s.spec, "powder");
-  w.steel = scene::material_named(s.spec, "steel");
+  w.powder = scene::powder_material(s.spec);
+  w.steel = scene::tool_material(s.spec);
   w.cache = s.cache.empty() ? s.out / ".cache" : s.cache;
   const mesh::DieOptions options = die_options(s, grains, shoe, source);
   w.die = mesh::prepare_die(source.file, options, w.cache);

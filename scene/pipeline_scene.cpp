@@ -151,7 +151,7 @@ KeyTable<P> make_pipeline_keys() {
 
 std::vector<dem::Material> default_materials() {
   dem::Material powder;
-  powder.name = "powder";
+  powder.name = powder_material_name;
   powder.density = 7800;          // solid steel/iron
   powder.youngs_modulus = 1e7;    // softened from 2e11 Pa: see describe()
   powder.poisson_ratio = 0.3;
@@ -159,7 +159,7 @@ std::vector<dem::Material> default_materials() {
   powder.sliding_friction = 0.5;
   powder.rolling_friction = 0.1;
   dem::Material steel;
-  steel.name = "steel";
+  steel.name = tool_material_name;
   steel.density = 7800;
   steel.youngs_modulus = 2.1e11;
   steel.poisson_ratio = 0.3;
@@ -183,10 +183,10 @@ const KeyTable<PipelineScene>& pipeline_keys() {
   return keys;
 }
 
-int material_named(const dem::ModelSpec& spec, const std::string& name) {
+int material_named(const dem::ModelSpec& spec, std::string_view name) {
   for (std::size_t m = 0; m < spec.materials.size(); ++m)
     if (spec.materials[m].name == name) return int(m);
-  throw diefill::InputError("scene", "materials", "has no material named \"" + name + "\"", "Define it");
+  throw diefill::InputError("scene", "materials", "has no material named \"" + std::string(name) + "\"", "Define it");
 }
 
 dem::ModelSpec coarse_grained_spec(const dem::ModelSpec& spec, double alpha) {
@@ -222,8 +222,8 @@ PipelineScene load_pipeline_scene(const std::optional<std::filesystem::path>& sc
            "Give gravity a negative z component, e.g. [0, 0, -9.81]");
   // Powder slides on the polished die table more easily than on itself, unless told otherwise.
   if (s.spec.interactions.empty())
-    s.spec.interactions.push_back({int(std::find(names.begin(), names.end(), "powder") - names.begin()),
-                                   int(std::find(names.begin(), names.end(), "steel") - names.begin()), std::nullopt, 0.3,
+    s.spec.interactions.push_back({int(std::find(names.begin(), names.end(), powder_material_name) - names.begin()),
+                                   int(std::find(names.begin(), names.end(), tool_material_name) - names.begin()), std::nullopt, 0.3,
                                    0.05});
   return s;
 }

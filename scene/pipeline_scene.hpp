@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "dem/model.hpp"
@@ -77,8 +78,13 @@ const KeyTable<PipelineScene>& pipeline_keys();
 // types and values out of their range are errors naming the key, with file and line.
 PipelineScene load_pipeline_scene(const std::optional<std::filesystem::path>& scene_file,
                                   const std::vector<std::string>& overrides);
-// Index of the material `name` ("powder", "steel"); InputError when the scene lacks it.
-int material_named(const dem::ModelSpec& spec, const std::string& name);
+// The pipeline's materials by role, named once: the powder's grains, and the steel of the die, the
+// shoe and the table. A scene changes them through [[materials]] entries of these names.
+inline constexpr std::string_view powder_material_name = "powder", tool_material_name = "steel";
+// Index of the material `name`; InputError when the scene lacks it.
+int material_named(const dem::ModelSpec& spec, std::string_view name);
+inline int powder_material(const dem::ModelSpec& spec) { return material_named(spec, powder_material_name); }
+inline int tool_material(const dem::ModelSpec& spec) { return material_named(spec, tool_material_name); }
 // The contact laws for grains `alpha` times the real powder's size (docs/PHYSICS.md §4). Hertz,
 // damping to a restitution, rolling and SJKR cohesion scale by themselves; a linear spring must
 // stiffen as α, since contact.linear_stiffness is given for the real powder.

@@ -36,7 +36,7 @@ SimulatedTests simulated_tests(const scene::PipelineScene& scene, const Measured
   scene::PipelineScene s = scene;
   s.particle_diameter = m.particle_diameter;
   s.diameter_spread = m.diameter_spread;
-  s.spec.materials[std::size_t(scene::material_named(s.spec, "powder"))].density = m.material_density;
+  s.spec.materials[std::size_t(scene::powder_material(s.spec))].density = m.material_density;
   // As coarse as keeps the orifice `orifice_grains` grains wide: Beverloo's k·d then corrects
   // the boundary (docs/PHYSICS.md §4), and every test holds the same few thousand grains
   // whatever the real powder's size.

@@ -78,7 +78,7 @@ CoarseGrainingSizes coarse_graining_sizes(bool reduced) {
 // powder's stiffness and twice the default time-step fraction (the speed-accuracy study
 // measures what each costs in accuracy).
 scene::PipelineScene affordable(scene::PipelineScene s) {
-  s.spec.materials[std::size_t(scene::material_named(s.spec, "powder"))].youngs_modulus *= 0.1;
+  s.spec.materials[std::size_t(scene::powder_material(s.spec))].youngs_modulus *= 0.1;
   s.spec.time_step_fraction = 0.3;
   return s;
 }
@@ -313,7 +313,7 @@ nlohmann::json coarse_graining_results(const std::vector<FactorResult>& results,
   const SlotContainer& box = setup.box;
   nlohmann::json r = {
       {"factors", factors_json(results, setup.fill_ring)},
-      {"settings", {{"powder_youngs_modulus_pa", scene.spec.materials[std::size_t(scene::material_named(scene.spec, "powder"))].youngs_modulus},
+      {"settings", {{"powder_youngs_modulus_pa", scene.spec.materials[std::size_t(scene::powder_material(scene.spec))].youngs_modulus},
                     {"time_step_fraction", scene.spec.time_step_fraction},
                     {"beverloo_k", beverloo_k},
                     {"beverloo_k_that_makes_the_rates_one_law", c.k_across},

@@ -106,7 +106,7 @@ RunResult run_setting(const scene::PipelineScene& scene, const Setting& setting,
   r.setting = setting;
   scene::PipelineScene s = scene;
   s.coarse_graining *= setting.coarser;
-  s.spec.materials[std::size_t(scene::material_named(s.spec, "powder"))].youngs_modulus *= setting.stiffness;
+  s.spec.materials[std::size_t(scene::powder_material(s.spec))].youngs_modulus *= setting.stiffness;
   s.spec.time_step_fraction = setting.time_step_fraction;
   s.die_voxel_fraction = setting.voxel_fraction;
   s.seed += setting.seed_offset;
