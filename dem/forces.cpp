@@ -1,7 +1,5 @@
 #include "dem/forces.hpp"
 
-#include <fmt/core.h>
-
 #include <deque>
 #include <vector>
 
