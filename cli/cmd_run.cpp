@@ -1,10 +1,8 @@
 // `diefill run TARGET`: the pipeline on a die mesh, on every mesh of a folder, or on a scene.
 // `diefill scene [TARGET]`: the resolved scene, every default with its reason.
 #include <fmt/core.h>
-#include <fmt/ranges.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cctype>
 #include <string_view>
 
@@ -33,15 +31,15 @@ bool is_scene(const fs::path& p) { return p.extension() == ".toml"; }
 
 scene::PipelineScene scene_for(const fs::path& target, const std::vector<std::string>& overrides) {
   scene::PipelineScene scene = is_scene(target) ? scene::load_pipeline_scene(target, overrides) : scene::load_pipeline_scene(std::nullopt, overrides);
-  if (!is_scene(target) && !target.empty()) scene.die = target;
+  if (!is_scene(target) && !target.empty()) scene.die.file = target;
   return scene;
 }
 
 void apply_command_line(scene::PipelineScene& scene, const RunCommand& c) {
-  if (!c.out.empty()) scene.out = c.out;
+  if (!c.out.empty()) scene.output.directory = c.out;
   if (c.threads) scene.threads = *c.threads;
-  if (c.up) scene.die_up = *c.up;
-  if (c.units) scene.die_units = *c.units;
+  if (c.up) scene.die.up = mesh::parse_up(*c.up, "--up");
+  if (c.units) scene.die.units = mesh::parse_unit_or_auto(*c.units, "--units");
   scene.force = c.force;
 }
 
@@ -111,27 +109,12 @@ int run_planned(const RunCommand& c) {
   fmt::print("{}", pipeline::plan_table(plan));
   if (!plan.chosen)
     throw diefill::InputError("--budget", c.budget, "fits no way to the answer", "Raise --budget (`diefill plan` lists each way's time)");
-  const pipeline::PlanOption& chosen = plan.options[*plan.chosen];
+  const pipeline::PlannedRun planned = pipeline::planned_run(plan, command_scene(c, {}));
   RunCommand run = c;
   run.plan = false;
-  // The plan sized each grain size without the grain budget: the run may take what it chose.
-  std::size_t grains = command_scene(c, {}).max_grains;
-  for (const pipeline::PlanLevel& l : plan.levels)
-    if (std::find(chosen.alphas.begin(), chosen.alphas.end(), l.alpha) != chosen.alphas.end()) grains = std::max(grains, l.size.grains + 1);
-  run.overrides.push_back(fmt::format("powder.max_grains={}", grains));
-  if (chosen.kind == "ladder") {
-    run.ladder = fmt::format("{}", fmt::join(chosen.alphas, ","));
-  } else {
-    run.overrides.push_back(fmt::format("powder.coarse_graining={}", chosen.alphas.front()));
-    if (chosen.seeds > 1) {
-      // As its command says: finer voxels for the seeds (pipeline/run_plan.cpp).
-      const double d = chosen.alphas.front() * command_scene(c, {}).particle_diameter;
-      run.seeds = chosen.seeds;
-      run.overrides.push_back(fmt::format("density.voxel={:.3g}", 2 * d / std::cbrt(double(chosen.seeds))));
-      run.overrides.push_back(fmt::format("fem.element_size={:.3g}", 2 * d));
-    }
-  }
-  if (chosen.kind == "ladder") run.seeds = chosen.seeds;
+  run.overrides.insert(run.overrides.end(), planned.overrides.begin(), planned.overrides.end());
+  run.ladder = planned.ladder;
+  run.seeds = planned.seeds;
   return run_pipeline(run);
 }
 
@@ -165,13 +148,13 @@ int run_swept(const RunCommand& c, const std::shared_ptr<dem::Exchange>& ranks) 
 int run_one_die(const RunCommand& c, const std::shared_ptr<dem::Exchange>& ranks) {
   const bool root = !ranks || ranks->rank() == 0;
   const scene::PipelineScene scene = command_scene(c, {});
-  if (scene.die.empty())
+  if (scene.die.file.empty())
     throw diefill::InputError(c.target.string(), "die.file", "names no die", "Give [die] file = \"...\" or run a mesh");
-  const pipeline::DieRun run = pipeline::run_die_fill(scene, scene.die, c.resume, ranks);
+  const pipeline::DieRun run = pipeline::run_die_fill(scene, scene.die.file, c.resume, ranks);
   if (run.interrupted) {
     if (!root) return diefill::exit_interrupted;
     if (fs::exists(run.dir / "checkpoint.bin"))
-      fmt::print(stderr, "interrupted; resume with `{}`{}\n", resume_command(c, scene.out),
+      fmt::print(stderr, "interrupted; resume with `{}`{}\n", resume_command(c, scene.output.directory),
                  ranks ? " under the same mpirun" : "");
     else
       fmt::print(stderr, "interrupted before the shoe moved: no checkpoint to resume from; rerun the command to start again\n");
@@ -202,19 +185,7 @@ int run_scene(const SceneCommand& c) {
   }
   scene::PipelineScene scene = scene_for(c.target, c.overrides);
   scene.force = c.force;
-  // Every check a run makes before its first step but those that need the die's distance field
-  // (its repair, whether grains enter it), which the run builds and caches.
-  pipeline::preflight_laws(scene);
-  std::string size;
-  if (!scene.die.empty()) {
-    const pipeline::DieSource die = pipeline::read_die(scene, scene.die);
-    pipeline::ShoePlan shoe = plan_shoe(scene, die);
-    const pipeline::GrainSizing grains = size_grains(scene, shoe, die.file.name);
-    pipeline::set_clearance(scene, grains, die.table_z, shoe);
-    const pipeline::RunSize run = preflight(scene, die, shoe, grains);
-    pipeline::refuse_oversized(scene, run, die.file.source);
-    size = pipeline::describe_size(run, die.file.name);
-  }
+  const std::string size = pipeline::check_before_run(scene);
   fmt::print("{}{}", scene::describe(scene), size);
   return 0;
 }

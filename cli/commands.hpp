@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "bench/cases.hpp"
+
 namespace cli {
 
 std::string version_text();
@@ -81,17 +83,8 @@ struct SimulateCommand {
 int run_simulate(const SimulateCommand& command);
 
 struct BenchCommand {
-  std::vector<std::string> cases;
+  bench::Request request;
   std::filesystem::path json_out;
-  std::vector<int> threads;
-  int steps = 2000;
-  std::filesystem::path cache = "out/bench";
-  std::filesystem::path pack;  // liggghts: the settled pack (LAMMPS dump)
-  std::filesystem::path stl;   // liggghts: the container (mm)
-  std::vector<std::size_t> sizes = {5000, 15000, 50000, 150000, 500000};  // scaling: grain counts
-  std::int64_t grains = 10'000'000;  // mpi-bed: the bed's grains
-  std::int64_t checkpoint_at = 0;    // mpi-bed: the step at which a checkpoint is written (0: none)
-  std::filesystem::path resume;      // mpi-bed: go on from this checkpoint
 };
 int run_bench(const BenchCommand& command);
 

@@ -115,17 +115,17 @@ void add_simulate(CLI::App& root, cli::SimulateCommand& c, std::function<int()>&
 
 void add_bench(CLI::App& root, cli::BenchCommand& c, std::function<int()>& action) {
   CLI::App* cmd = root.add_subcommand("bench", "Performance cases; JSON results");
-  cmd->add_option("CASE", c.cases, "ring-10k, ring-100k (default both), liggghts, scaling (tiles of the LIGGGHTS pack, 5k to 500k grains), run-ring (the default pipeline on the ring, end to end), mpi-bed (under mpirun: a bed of --grains split over the ranks, stepped to step --steps)");
+  cmd->add_option("CASE", c.request.cases, "ring-10k, ring-100k (default both), liggghts, scaling (tiles of the LIGGGHTS pack, 5k to 500k grains), run-ring (the default pipeline on the ring, end to end), mpi-bed (under mpirun: a bed of --grains split over the ranks, stepped to step --steps)");
   cmd->add_option("--json", c.json_out, "Write the results here instead of standard output");
-  cmd->add_option("--threads", c.threads, "Thread counts to time (default 1 2)");
-  cmd->add_option("--steps", c.steps, "Timed steps per run")->capture_default_str();
-  cmd->add_option("--cache", c.cache, "Folder for prepared packs and SDFs")->capture_default_str();
-  cmd->add_option("--pack", c.pack, "liggghts: settled pack (LAMMPS dump: id x y z radius vx vy vz)");
-  cmd->add_option("--stl", c.stl, "liggghts: container mesh (mm)");
-  cmd->add_option("--sizes", c.sizes, "scaling: grain counts")->capture_default_str();
-  cmd->add_option("--grains", c.grains, "mpi-bed: grains in the bed")->capture_default_str();
-  cmd->add_option("--checkpoint-at", c.checkpoint_at, "mpi-bed: write a checkpoint (CACHE/mpi-bed/checkpoint.bin) at this step");
-  cmd->add_option("--resume", c.resume, "mpi-bed: go on from this checkpoint to --steps");
+  cmd->add_option("--threads", c.request.threads, "Thread counts to time (default 1 2)");
+  cmd->add_option("--steps", c.request.steps, "Timed steps per run")->capture_default_str();
+  cmd->add_option("--cache", c.request.cache, "Folder for prepared packs and SDFs")->capture_default_str();
+  cmd->add_option("--pack", c.request.pack, "liggghts: settled pack (LAMMPS dump: id x y z radius vx vy vz)");
+  cmd->add_option("--stl", c.request.stl, "liggghts: container mesh (mm)");
+  cmd->add_option("--sizes", c.request.sizes, "scaling: grain counts")->capture_default_str();
+  cmd->add_option("--grains", c.request.grains, "mpi-bed: grains in the bed")->capture_default_str();
+  cmd->add_option("--checkpoint-at", c.request.checkpoint_at, "mpi-bed: write a checkpoint (CACHE/mpi-bed/checkpoint.bin) at this step");
+  cmd->add_option("--resume", c.request.resume, "mpi-bed: go on from this checkpoint to --steps");
   cmd->callback([&] { action = [&] { return cli::run_bench(c); }; });
 }
 

@@ -36,9 +36,9 @@ CavityBox cavity_box(const mesh::PreparedDie& die) {
 // Gaussian kernel of `width` over the identically smoothed cavity (the kernel method).
 post::DensityField binned_field(const std::vector<post::Grain>& grains, const CavityBox& c,
                                 const mesh::WallField& walls, double voxel,
-                                const std::string& method, double width, const DensitySettings& s) {
+                                scene::DensityMethod method, double width, const DensitySettings& s) {
   post::DensityField f;
-  const post::Vec3 reach = post::Vec3::Constant(method == "gaussian" ? 3 * width : 0.0);  // every kernel whole
+  const post::Vec3 reach = post::Vec3::Constant(method == scene::DensityMethod::gaussian ? 3 * width : 0.0);  // every kernel whole
   f.grid = post::grid_covering(c.lo - reach, c.hi + reach, voxel,
                                post::Vec3(c.centre.x(), c.centre.y(), c.container ? c.lo.z() : c.hi.z()));
   f.centre = c.centre;
@@ -48,18 +48,16 @@ post::DensityField binned_field(const std::vector<post::Grain>& grains, const Ca
   const post::CavityVolumes cavity =
       post::cavity_fractions(f.grid, [&](const post::Vec3& p) { return walls.signed_distance(p); }, c.lo, c.hi, s.depth);
   f.cavity = cavity.fraction;
-  if (method == "exact") {
+  if (method == scene::DensityMethod::exact) {
     post::bin_exact(grains, f.grid, f.solid);
     f.corrected = post::correct_for_walls(f.grid, f.solid, f.cavity, s.min_cavity);
-  } else if (method == "gaussian") {
+  } else {
     post::bin_gaussian(grains, f.grid, width, f.solid);
     const std::vector<double> smoothed_cavity = post::smooth_gaussian(f.grid, cavity, width);
     f.corrected = post::correct_for_walls(f.grid, f.solid, smoothed_cavity, s.min_cavity);
     f.metadata["width_m"] = fmt::format("{:.9g}", width);
-  } else {
-    throw diefill::InputError("density", "method", "'" + method + "' is not a binning method", "Use exact or gaussian");
   }
-  f.metadata["method"] = method;
+  f.metadata["method"] = std::string(scene::choice_name(scene::density_methods, method));
   return f;
 }
 
@@ -118,7 +116,7 @@ DensityResult compute_density(const std::vector<post::Grain>& grains, const mesh
   r.field.metadata["coarse_graining"] = fmt::format("{}", s.coarse_graining);
   r.stats = post::statistics(r.field);
   if (s.smoothed_width_m > 0) {
-    r.smoothed = binned_field(grains, c, walls, s.smoothed_width_m, "gaussian", s.smoothed_width_m, s);
+    r.smoothed = binned_field(grains, c, walls, s.smoothed_width_m, scene::DensityMethod::gaussian, s.smoothed_width_m, s);
     r.smoothed->material_density = material_density;
     r.smoothed->metadata.insert(r.field.metadata.begin(), r.field.metadata.end());  // the rest: the same grains
     r.smoothed_stats = post::statistics(*r.smoothed);

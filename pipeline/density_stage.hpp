@@ -11,12 +11,13 @@
 
 #include "mesh/die.hpp"
 #include "postprocess/field.hpp"
+#include "scene/choices.hpp"
 
 namespace pipeline {
 
 struct DensitySettings {
   double voxel_m = 1e-3;           // density voxel edge
-  std::string method = "exact";    // "exact" | "gaussian"
+  scene::DensityMethod method = scene::DensityMethod::exact;
   double width_m = 0;              // Gaussian width (default: one voxel)
   double min_cavity = 0.25;        // voxels with less cavity are merged with a neighbour
   int depth = 3;                   // cavity-fraction subdivision levels

@@ -38,11 +38,17 @@ FillWalls walls_rank0_first(const scene::PipelineScene& s, const DieSource& sour
 
 }  // namespace
 
+std::string check_before_run(const scene::PipelineScene& s) {
+  preflight_laws(s);
+  if (s.die.file.empty()) return {};
+  const auto [source, shoe, grains] = lay_out_fill(s, s.die.file);
+  const RunSize size = preflight(s, source, shoe, grains);
+  refuse_oversized(s, size, source.file.source);
+  return describe_size(size, source.file.name);
+}
+
 FillSetup set_up_fill(const scene::PipelineScene& s, const fs::path& die_mesh, const std::shared_ptr<dem::Exchange>& ranks) {
-  DieSource source = read_die(s, die_mesh);
-  ShoePlan shoe = plan_shoe(s, source);
-  const GrainSizing grains = size_grains(s, shoe, source.file.name);
-  set_clearance(s, grains, source.table_z, shoe);
+  auto [source, shoe, grains] = lay_out_fill(s, die_mesh);
   refuse_oversized(s, preflight(s, source, shoe, grains), source.file.source);
   FillWalls walls = walls_rank0_first(s, source, grains, shoe, ranks);
   return {std::move(source), std::move(shoe), grains, std::move(walls)};
@@ -57,7 +63,7 @@ DieRun run_die_fill(const scene::PipelineScene& s, const fs::path& die_mesh, boo
   const auto& [source, shoe, grains, walls] = setup;
   DieRun run;
   run.die = walls.die.name;
-  run.dir = s.out / run.die;
+  run.dir = s.output.directory / run.die;
   fs::create_directories(run.dir);
 
   const std::optional<SettledShoe> settled = fill_and_settle_shoe(s, walls, grains, shoe, source.table_z, ranks);

@@ -35,6 +35,11 @@ struct FillSetup {
   GrainSizing grains;
   FillWalls walls;
 };
+// Every check a run makes before its first step but those that need the die's distance field
+// (its repair, whether grains enter the cavity), which the run builds and caches; returns the
+// run's size described (`diefill scene`), empty when the scene names no die.
+std::string check_before_run(const scene::PipelineScene& scene);
+
 FillSetup set_up_fill(const scene::PipelineScene& scene, const std::filesystem::path& die_mesh,
                       const std::shared_ptr<dem::Exchange>& ranks = nullptr);
 

@@ -128,8 +128,8 @@ nlohmann::json write_ensemble(const scene::PipelineScene& first, const std::vect
                                 "Look at that seed's run: an ensemble of it has no mean field");
   // The seeds' setting, as the sweep ran them (one cache), from the cache the runs filled.
   scene::PipelineScene scene = first;
-  if (scene.cache.empty()) scene.cache = first.out / ".cache";
-  const FillSetup setup = set_up_fill(scene, scene.die);
+  if (scene.output.cache.empty()) scene.output.cache = first.output.directory / ".cache";
+  const FillSetup setup = set_up_fill(scene, scene.die.file);
   Realisations realisations;
   for (const DieRun& r : runs) realisations.cavity.push_back(r.cavity_grains), realisations.curves.push_back(r.fill_curve);
   diefill::StagingFolder out(dir);
@@ -157,7 +157,7 @@ DieRun run_ensemble(const std::function<scene::PipelineScene(const std::vector<s
   const std::vector<DieRun> runs = run_sweep(load, {"simulation.seed", values}, ranks);
   DieRun ensemble;
   ensemble.die = runs.front().die;
-  ensemble.dir = first.out / ensemble.die;
+  ensemble.dir = first.output.directory / ensemble.die;
   ensemble.interrupted = runs.size() < values.size() || runs.back().interrupted;
   if (ensemble.interrupted) return ensemble;
   // Rank 0 writes; should that fail, every rank learns it before a ladder's next level.

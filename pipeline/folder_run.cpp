@@ -77,8 +77,8 @@ int run_folder(const scene::PipelineScene& scene, const fs::path& folder, bool r
     }
   }
   if (root) {
-    diefill::write_file_atomic(scene.out / "summary.csv", csv);
-    diefill::write_file_atomic(scene.out / "summary.md", md);
+    diefill::write_file_atomic(scene.output.directory / "summary.csv", csv);
+    diefill::write_file_atomic(scene.output.directory / "summary.md", md);
     fmt::print("{}", md);
   }
   return unstable > 0 ? diefill::exit_unstable : refused > 0 ? diefill::exit_bad_input : diefill::exit_ok;

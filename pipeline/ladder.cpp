@@ -58,12 +58,12 @@ scene::PipelineScene level_scene(const std::function<scene::PipelineScene(const 
                           const std::vector<std::string>& more) {
   const scene::PipelineScene plain = load({});
   std::vector<std::string> overrides = {fmt::format("powder.coarse_graining={}", alpha)};
-  if (plain.density_voxel == 0) overrides.push_back(fmt::format("density.voxel={}", 2 * finest));
-  if (plain.fem_element_size == 0) overrides.push_back(fmt::format("fem.element_size={}", 2 * finest));
+  if (plain.density.voxel == 0) overrides.push_back(fmt::format("density.voxel={}", 2 * finest));
+  if (plain.fem.element_size == 0) overrides.push_back(fmt::format("fem.element_size={}", 2 * finest));
   overrides.insert(overrides.end(), more.begin(), more.end());
   scene::PipelineScene s = load(overrides);
-  s.out = plain.out / fmt::format("powder.coarse_graining={}", alpha);
-  if (s.cache.empty()) s.cache = plain.out / ".cache";  // one die field and settled shoes for every level
+  s.output.directory = plain.output.directory / fmt::format("powder.coarse_graining={}", alpha);
+  if (s.output.cache.empty()) s.output.cache = plain.output.directory / ".cache";  // one die field and settled shoes for every level
   return s;
 }
 
@@ -71,20 +71,20 @@ scene::PipelineScene level_scene(const std::function<scene::PipelineScene(const 
 void check_levels(const std::function<scene::PipelineScene(const std::vector<std::string>&)>& load, const Ladder& ladder, double finest) {
   for (double alpha : ladder.alphas) {
     const scene::PipelineScene s = level_scene(load, alpha, finest, {});
-    const DieSource die = read_die(s, s.die);
-    const GrainSizing grains = size_grains(s, plan_shoe(s, die), die.file.name);
+    const DieSource die = read_die(s.die, s.die.file);
+    const GrainSizing grains = size_grains(s.powder, s.shoe.fill_height, plan_shoe(s.shoe, s.motion, die), die.file.name);
     if (std::abs(grains.alpha - alpha) > 1e-9 * alpha)
       throw diefill::InputError("--ladder", fmt::format("{}", alpha),
                                 fmt::format("needs {:.0f} grains, more than powder.max_grains = {}", double(grains.count) * std::pow(grains.alpha / alpha, 3),
-                                            s.max_grains),
+                                            s.powder.max_grains),
                                 "Raise powder.max_grains, or give coarser levels");
   }
   const scene::PipelineScene coarsest = level_scene(load, ladder.alphas.front(), finest, {});
-  const DieSource die = read_die(coarsest, coarsest.die);
-  const double d = coarsest.grain_diameter();
+  const DieSource die = read_die(coarsest.die, coarsest.die.file);
+  const double d = coarsest.powder.grain_diameter();
   const mesh::Box box = mesh::bounding_box(die.file.mesh);
   const double spacing = std::max(std::min(box.size().minCoeff() / 8, grains_across_needed * d / 8), std::cbrt(box.size().prod() / 5e5));
-  const Refusal r = refuse_thin_features(mesh::feature_widths(die.file.mesh, die.table_z, spacing), d, coarsest.particle_diameter);
+  const Refusal r = refuse_thin_features(mesh::feature_widths(die.file.mesh, die.table_z, spacing), d, coarsest.powder.particle_diameter);
   if (!r.reason.empty())
     throw diefill::InputError(die.file.source, "--ladder", r.reason,
                               fmt::format("Give a coarsest level of α = {:.2g} or less (`diefill scene` says what each level takes)", r.alpha_needed));
@@ -190,7 +190,7 @@ std::string write_extrapolation(const std::vector<Level>& levels, const Ladder& 
 DieRun run_ladder(const std::function<scene::PipelineScene(const std::vector<std::string>& overrides)>& load, const Ladder& ladder,
                   const std::shared_ptr<dem::Exchange>& ranks) {
   const scene::PipelineScene plain = load({});
-  const double finest = ladder.alphas.back() * plain.particle_diameter;
+  const double finest = ladder.alphas.back() * plain.powder.particle_diameter;
   check_levels(load, ladder, finest);
   std::vector<Level> levels;
   for (double alpha : ladder.alphas) {
@@ -204,10 +204,10 @@ DieRun run_ladder(const std::function<scene::PipelineScene(const std::vector<std
   if (levels.empty()) return out;
   const double target_alpha = ladder.extrapolate_to.value_or(1.0);
   out.die = levels.back().report.at("/die/name"_json_pointer).get<std::string>();
-  out.dir = plain.out / out.die;
+  out.dir = plain.output.directory / out.die;
   out.report = levels.back().report;
   diefill::StagingFolder staging(out.dir);
-  const std::string refused = write_extrapolation(levels, ladder, target_alpha, target_alpha * plain.particle_diameter,
+  const std::string refused = write_extrapolation(levels, ladder, target_alpha, target_alpha * plain.powder.particle_diameter,
                                                   out.report["extrapolation"], staging.path());
   diefill::write_file_atomic(staging / "report.json", out.report.dump(2) + "\n");
   staging.commit();

@@ -25,11 +25,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-DensitySettings density_settings(const scene::PipelineScene& scene, const GrainSizing& grains) {
+DensitySettings density_settings(const scene::DensitySettings& density, const GrainSizing& grains) {
   DensitySettings ds;
-  ds.voxel_m = scene.density_voxel > 0 ? scene.density_voxel : 2 * grains.diameter;
-  ds.method = scene.density_method;
-  ds.smoothed_width_m = scene.density_smoothed_width > 0 ? scene.density_smoothed_width : 0.5 * grains.diameter;
+  ds.voxel_m = density.voxel > 0 ? density.voxel : 2 * grains.diameter;
+  ds.method = density.method;
+  ds.smoothed_width_m = density.smoothed_width > 0 ? density.smoothed_width : 0.5 * grains.diameter;
   ds.coarse_graining = grains.alpha;
   return ds;
 }
@@ -44,7 +44,7 @@ nlohmann::json write_density_field(const FillSetting& c, const Realisations& r, 
     diefill::log::warn("{}: no grain entered the cavity; no density field", c.walls.die.name);
     return {{"mass_kg", 0.0}, {"fill_ratio", 0.0}, {"voxel_m", 0.0}};
   }
-  const DensitySettings ds = density_settings(c.scene, c.grains);
+  const DensitySettings ds = density_settings(c.scene.density, c.grains);
   std::vector<DensityResult> fields;
   std::vector<nlohmann::json> figures;
   for (const std::vector<post::Grain>& grains : r.cavity) {
@@ -60,10 +60,10 @@ nlohmann::json write_density_field(const FillSetting& c, const Realisations& r, 
 
 // The FEM hand-off (fem/), on elements as large as the density voxels unless the scene says.
 nlohmann::json write_fem_section(const FillSetting& c, const Realisations& r, const nlohmann::json& fill, const fs::path& dir) {
-  if (fill.at("voxel_m").get<double>() <= 0 || c.scene.fem_elements == "none") return nullptr;
-  FemSettings settings = fem_settings(c.grains.diameter, fill.at("voxel_m").get<double>(), c.scene.fem_element_size);
-  settings.quadratic = c.scene.fem_elements == "quadratic";
-  settings.compaction = c.scene.fem_compaction == "calculix";
+  if (fill.at("voxel_m").get<double>() <= 0 || c.scene.fem.elements == scene::FemElements::none) return nullptr;
+  FemSettings settings = fem_settings(c.grains.diameter, fill.at("voxel_m").get<double>(), c.scene.fem.element_size);
+  settings.quadratic = c.scene.fem.elements == scene::FemElements::quadratic;
+  settings.compaction = c.scene.fem.compaction == scene::FemCompaction::calculix;
   try {
     return write_fem_outputs(r.cavity, c.walls.die, *c.walls.die_field, powder_density(c.walls), fill.at("mass_kg"), settings, dir);
   } catch (const mesh::TetMeshingStopped&) {
@@ -113,7 +113,7 @@ nlohmann::json run_checks(const FillRecord& r, const nlohmann::json& fem) {
 nlohmann::json report_json(const FillRecord& r, const nlohmann::json& fill, const nlohmann::json& fem) {
   const scene::PipelineScene& s = r.scene;
   const mesh::PreparedDie& die = r.walls.die;
-  const bool clumps = !s.shape_mesh.empty();
+  const bool clumps = !s.powder.shape_mesh.empty();
   const double steps = double(r.fill.loop.steps);
   const nlohmann::json checks = run_checks(r, fem);
   return {
@@ -139,14 +139,14 @@ nlohmann::json report_json(const FillRecord& r, const nlohmann::json& fill, cons
         {"material_density", r.walls.spec.materials[std::size_t(r.walls.powder)].density},
         {"coarse_graining", r.grains.alpha},
         {"grain_diameter_m", r.grains.diameter},
-        {"shape", clumps ? s.shape_mesh : "sphere"},
+        {"shape", clumps ? s.powder.shape_mesh : "sphere"},
         {"spheres_per_grain", clumps ? r.fill.state.size() / std::max<std::size_t>(1, r.fill.state.bodies.size()) : std::size_t{1}}}},
       {"shoe",
        {{"length_m", r.shoe.length},
         {"width_m", r.shoe.width},
-        {"width_requested_m", s.shoe_width},
-        {"speed_m_s", s.speed},
-        {"passes", s.passes}}},
+        {"width_requested_m", s.shoe.width},
+        {"speed_m_s", s.motion.speed},
+        {"passes", s.motion.passes}}},
       {"fill", fill},
       {"fem", fem},
       {"particles",

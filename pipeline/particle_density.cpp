@@ -45,7 +45,7 @@ int particle_density(const ParticleDensityRequest& r) {
   const mesh::WallField walls = die.sdf.wall_field(die.solid);
   DensitySettings s;
   s.voxel_m = r.voxel_m > 0 ? r.voxel_m : 4 * r_max;
-  s.method = r.method;
+  s.method = scene::parse_choice(scene::density_methods, r.method, "--method");
   s.width_m = r.width_m;
   s.smoothed_width_m = r.smoothed_width_m > 0 ? r.smoothed_width_m : r_max;  // as the pipeline: half a diameter
   s.coarse_graining = r.coarse_graining;
@@ -54,7 +54,7 @@ int particle_density(const ParticleDensityRequest& r) {
   write_density(result, out.path());
   nlohmann::json report = {{"die", {{"name", die.name}, {"source", die.source}, {"sha256", die.sha256}}},
                            {"particles", {{"source", r.particles.string()}, {"grains", grains.size()}}},
-                           {"density", {{"voxel_m", s.voxel_m}, {"method", s.method}, {"smoothed_width_m", s.smoothed_width_m}, {"material_density", material_density},
+                           {"density", {{"voxel_m", s.voxel_m}, {"method", std::string(scene::choice_name(scene::density_methods, s.method))}, {"smoothed_width_m", s.smoothed_width_m}, {"material_density", material_density},
                                         {"coarse_graining", r.coarse_graining}}},
                            {"fill", statistics_json(result.stats)}};
   if (r.fem) {

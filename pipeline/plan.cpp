@@ -29,12 +29,11 @@ constexpr double bed_solid_fraction = 0.6;
 
 }  // namespace
 
-DieSource read_die(const scene::PipelineScene& scene, const std::filesystem::path& die_mesh) {
-  if (mesh::parse_role(scene.die_role, "die.role") != mesh::WallRole::cavity)
+DieSource read_die(const scene::DieSettings& die_settings, const std::filesystem::path& die_mesh) {
+  if (die_settings.role != mesh::WallRole::cavity)
     throw diefill::InputError(die_mesh.string(), "die.role", "the pipeline fills a cavity", "Give the cavity mesh (role \"cavity\")");
   DieSource die;
-  die.file = mesh::read_die_file(die_mesh, mesh::parse_unit_or_auto(scene.die_units, "die.units"), mesh::parse_up(scene.die_up, "die.up"),
-                                 mesh::parse_parting(scene.die_parting, "die.parting"), scene.die_part);
+  die.file = mesh::read_die_file(die_mesh, die_settings.units, die_settings.up, die_settings.parting, die_settings.part);
   if (die.file.up_found && die.file.up != mesh::Up{} && !die.file.parting_z)
     diefill::log::warn("{}: its opening (a flat face at its extreme) faces {} in the file; turned so that it faces up. "
                        "Set die.up to choose another way",
@@ -60,51 +59,59 @@ DieSource read_die(const scene::PipelineScene& scene, const std::filesystem::pat
   return die;
 }
 
-ShoePlan plan_shoe(const scene::PipelineScene& s, const DieSource& die) {
+ShoePlan plan_shoe(const scene::ShoeSettings& shoe, const scene::MotionSettings& motion, const DieSource& die) {
   ShoePlan p;
-  p.length = s.shoe_length;
+  p.length = shoe.length;
   const double die_width = die.box.size().y();
-  p.width = s.trim_width ? std::min(s.shoe_width, die_width + 2 * s.side_margin) : s.shoe_width;
-  if (p.width < die_width + 2 * s.side_margin) {
+  p.width = shoe.trim_width ? std::min(shoe.width, die_width + 2 * shoe.side_margin) : shoe.width;
+  if (p.width < die_width + 2 * shoe.side_margin) {
     diefill::log::warn("the shoe ({:.4g} mm wide) does not cover the die ({:.4g} mm) with its side margin; widened to {:.4g} mm",
-                       s.shoe_width * 1e3, die_width * 1e3, (die_width + 2 * s.side_margin) * 1e3);
-    p.width = die_width + 2 * s.side_margin;
+                       shoe.width * 1e3, die_width * 1e3, (die_width + 2 * shoe.side_margin) * 1e3);
+    p.width = die_width + 2 * shoe.side_margin;
   }
   p.y_centre = 0.5 * (die.box.lo.y() + die.box.hi.y());
-  p.x_start = die.box.lo.x() - s.start_gap - 0.5 * p.length;
-  p.x_end = die.box.hi.x() + s.end_gap + 0.5 * p.length;
+  p.x_start = die.box.lo.x() - motion.start_gap - 0.5 * p.length;
+  p.x_end = die.box.hi.x() + motion.end_gap + 0.5 * p.length;
   p.motion.start_position = Vec3(p.x_start, p.y_centre, die.table_z);
-  for (int pass = 0; pass < s.passes; ++pass) {
-    add_stroke(p.motion, p.x_end - p.x_start, s.speed, s.acceleration);
-    if (s.dwell > 0) p.motion.segments.push_back({s.dwell, Vec3::Zero()});
-    if (s.return_stroke) add_stroke(p.motion, p.x_start - p.x_end, s.speed, s.acceleration);
+  for (int pass = 0; pass < motion.passes; ++pass) {
+    add_stroke(p.motion, p.x_end - p.x_start, motion.speed, motion.acceleration);
+    if (motion.dwell > 0) p.motion.segments.push_back({motion.dwell, Vec3::Zero()});
+    if (motion.return_stroke) add_stroke(p.motion, p.x_start - p.x_end, motion.speed, motion.acceleration);
   }
   for (const auto& seg : p.motion.segments) p.t_motion += seg.duration;
   return p;
 }
 
-GrainSizing size_grains(const scene::PipelineScene& s, const ShoePlan& shoe, const std::string& die_name) {
+GrainSizing size_grains(const scene::PowderSettings& powder, double fill_height, const ShoePlan& shoe, const std::string& die_name) {
   GrainSizing g;
-  g.diameter = s.grain_diameter();
-  const double bed = shoe.length * shoe.width * s.fill_height * bed_solid_fraction;
+  g.diameter = powder.grain_diameter();
+  const double bed = shoe.length * shoe.width * fill_height * bed_solid_fraction;
   double estimate = bed / (std::numbers::pi / 6 * std::pow(g.diameter, 3));
-  if (estimate > double(s.max_grains)) {
-    const double scale = std::cbrt(estimate / double(s.max_grains));
+  if (estimate > double(powder.max_grains)) {
+    const double scale = std::cbrt(estimate / double(powder.max_grains));
     diefill::log::warn("{}: {:.0f} grains of {:.3g} mm would exceed powder.max_grains = {}; using {:.3g} mm grains "
                        "(coarse graining {:.3g} instead of {:.3g})",
-                       die_name, estimate, g.diameter * 1e3, s.max_grains, g.diameter * scale * 1e3, s.coarse_graining * scale,
-                       s.coarse_graining);
+                       die_name, estimate, g.diameter * 1e3, powder.max_grains, g.diameter * scale * 1e3, powder.coarse_graining * scale,
+                       powder.coarse_graining);
     g.diameter *= scale;
-    estimate = double(s.max_grains);
+    estimate = double(powder.max_grains);
   }
   g.count = std::size_t(estimate);
-  g.r_max = 0.5 * g.diameter * (1 + s.diameter_spread);
-  g.alpha = g.diameter / s.particle_diameter;
+  g.r_max = 0.5 * g.diameter * (1 + powder.diameter_spread);
+  g.alpha = g.diameter / powder.particle_diameter;
   return g;
 }
 
-void set_clearance(const scene::PipelineScene& s, const GrainSizing& grains, double table_z, ShoePlan& shoe) {
-  shoe.motion.start_position.z() = table_z + s.clearance * grains.r_max;
+void set_clearance(double clearance, const GrainSizing& grains, double table_z, ShoePlan& shoe) {
+  shoe.motion.start_position.z() = table_z + clearance * grains.r_max;
+}
+
+FillLayout lay_out_fill(const scene::PipelineScene& s, const std::filesystem::path& die_mesh) {
+  FillLayout f{read_die(s.die, die_mesh), {}, {}};
+  f.shoe = plan_shoe(s.shoe, s.motion, f.source);
+  f.grains = size_grains(s.powder, s.shoe.fill_height, f.shoe, f.source.file.name);
+  set_clearance(s.shoe.clearance, f.grains, f.source.table_z, f.shoe);
+  return f;
 }
 
 }  // namespace pipeline

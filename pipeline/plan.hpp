@@ -16,7 +16,7 @@ struct DieSource {
   mesh::Box box;
   double table_z = 0;
 };
-DieSource read_die(const scene::PipelineScene& scene, const std::filesystem::path& die_mesh);
+DieSource read_die(const scene::DieSettings& die, const std::filesystem::path& die_mesh);
 
 // Where the shoe goes: its inner rectangle centred at (x, y_centre) on the table.
 struct ShoePlan {
@@ -40,9 +40,18 @@ struct GrainSizing {
 // has above the powder already in it, and the powder settles before the next, up to this many.
 inline constexpr int max_insertion_rounds = 4;
 
-ShoePlan plan_shoe(const scene::PipelineScene& scene, const DieSource& die);
-GrainSizing size_grains(const scene::PipelineScene& scene, const ShoePlan& shoe, const std::string& die_name);
+ShoePlan plan_shoe(const scene::ShoeSettings& shoe, const scene::MotionSettings& motion, const DieSource& die);
+GrainSizing size_grains(const scene::PowderSettings& powder, double fill_height, const ShoePlan& shoe, const std::string& die_name);
 // The shoe's start raised by the clearance under its walls, now that the grains are sized.
-void set_clearance(const scene::PipelineScene& scene, const GrainSizing& grains, double table_z, ShoePlan& shoe);
+void set_clearance(double clearance, const GrainSizing& grains, double table_z, ShoePlan& shoe);
+
+// The die read, the shoe laid over it and the grains sized for its powder: what a run's size, its
+// walls and its preflight follow from.
+struct FillLayout {
+  DieSource source;
+  ShoePlan shoe;
+  GrainSizing grains;
+};
+FillLayout lay_out_fill(const scene::PipelineScene& scene, const std::filesystem::path& die_mesh);
 
 }  // namespace pipeline

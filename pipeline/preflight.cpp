@@ -30,7 +30,7 @@ std::size_t steps_of(double duration, double dt) { return std::size_t(std::llrou
 
 dem::ModelSpec fill_laws(const scene::PipelineScene& s, const GrainSizing& grains, double die_depth) {
   dem::ModelSpec spec = scene::coarse_grained_spec(s.spec, grains.alpha);
-  spec.max_impact_speed = std::max(spec.max_impact_speed, std::sqrt(2 * spec.gravity.norm() * die_depth) + s.speed);
+  spec.max_impact_speed = std::max(spec.max_impact_speed, std::sqrt(2 * spec.gravity.norm() * die_depth) + s.motion.speed);
   return spec;
 }
 
@@ -39,16 +39,16 @@ namespace {
 // The grids the outputs bin on, each refused (InputError naming its key) when it would hold more
 // voxels than the limit: the density field, the smoothed field, the FEM hand-off's sub-voxels.
 void check_grids(const scene::PipelineScene& s, const DieSource& die, const GrainSizing& grains) {
-  const double density_voxel = s.density_voxel > 0 ? s.density_voxel : 2 * grains.diameter;
-  const double element = s.fem_element_size > 0 ? s.fem_element_size : density_voxel;
+  const double density_voxel = s.density.voxel > 0 ? s.density.voxel : 2 * grains.diameter;
+  const double element = s.fem.element_size > 0 ? s.fem.element_size : density_voxel;
   const struct {
     const char* key;
     double voxel;
     const char* remedy;
   } grids[] = {{"density.voxel", density_voxel, "Give a coarser density.voxel"},
-               {"density.smoothed_width", s.density_smoothed_width > 0 ? s.density_smoothed_width : 0.5 * grains.diameter,
+               {"density.smoothed_width", s.density.smoothed_width > 0 ? s.density.smoothed_width : 0.5 * grains.diameter,
                 "Give a coarser density.smoothed_width"},
-               {"fem.element_size", s.fem_elements == "none" ? 0.0 : std::min(0.25 * grains.diameter, 0.125 * element),
+               {"fem.element_size", s.fem.elements == scene::FemElements::none ? 0.0 : std::min(0.25 * grains.diameter, 0.125 * element),
                 "Give larger elements (fem.element_size; the hand-off's sub-voxels are an eighth of one at most), or set "
                 "fem.elements = \"none\""}};
   for (const auto& g : grids) {
@@ -71,24 +71,24 @@ RunSize preflight(const scene::PipelineScene& s, const DieSource& die, const Sho
   RunSize size;
   size.grains = grains.count;
   // The settling sees the scene's impact speed; the pass the raised one and the shoe's motion.
-  const dem::Model settling = compile_on_stand_ins(scene::coarse_grained_spec(s.spec, grains.alpha), grains.diameter, s.diameter_spread, s.source);
+  const dem::Model settling = compile_on_stand_ins(scene::coarse_grained_spec(s.spec, grains.alpha), grains.diameter, s.powder.diameter_spread, s.source);
   const dem::ModelSpec pass_laws = fill_laws(s, grains, die.box.size().z());
   if (pass_laws.max_impact_speed > s.spec.max_impact_speed)
     diefill::log::info("{}: impacts reach {:.3g} m/s in this die; time step set for them (simulation.max_impact_speed is {:.3g})",
                        die.file.name, pass_laws.max_impact_speed, s.spec.max_impact_speed);
-  const dem::Model pass = compile_on_stand_ins(pass_laws, grains.diameter, s.diameter_spread, s.source);
+  const dem::Model pass = compile_on_stand_ins(pass_laws, grains.diameter, s.powder.diameter_spread, s.source);
   dem::check_wall_travel("shoe", shoe.motion.top_speed(), pass.dt, pass.skin, s.source);
   size.settling_dt_s = settling.dt;
   size.pass_dt_s = pass.dt;
-  size.settling_steps = steps_of(s.shoe_settle_time, settling.dt);
-  size.pass_steps = steps_of(shoe.t_motion + s.die_settle_time, pass.dt);
+  size.settling_steps = steps_of(s.motion.shoe_settle_time, settling.dt);
+  size.pass_steps = steps_of(shoe.t_motion + s.motion.die_settle_time, pass.dt);
   size.particle_steps =
       double(size.grains) * (double(size.pass_steps) + double(max_insertion_rounds) * double(size.settling_steps));
   return size;
 }
 
 void preflight_laws(const scene::PipelineScene& s) {
-  compile_on_stand_ins(scene::coarse_grained_spec(s.spec, s.coarse_graining), s.grain_diameter(), s.diameter_spread, s.source);
+  compile_on_stand_ins(scene::coarse_grained_spec(s.spec, s.powder.coarse_graining), s.powder.grain_diameter(), s.powder.diameter_spread, s.source);
 }
 
 void refuse_oversized(const scene::PipelineScene& s, const RunSize& size, const std::string& source) {

@@ -68,14 +68,14 @@ double ladder_stderr(const std::vector<const PlanLevel*>& levels, int seeds, dou
 // 1/√(grains per voxel), so N seeds on voxels of 2d/N^(1/3) are as noisy as one on 2d (the
 // default), and resolve features N^(1/3) times finer; the elements stay at 2d.
 std::string single_command(const scene::PipelineScene& s, double alpha, double diameter, int seeds) {
-  if (seeds == 1) return fmt::format("diefill run {} --set powder.coarse_graining={}", s.die.string(), alpha);
+  if (seeds == 1) return fmt::format("diefill run {} --set powder.coarse_graining={}", s.die.file.string(), alpha);
   return fmt::format("diefill run {} --set powder.coarse_graining={} --seeds {} --set density.voxel={:.3g} --set fem.element_size={:.3g}",
-                     s.die.string(), alpha, seeds, 2 * diameter / std::cbrt(double(seeds)), 2 * diameter);
+                     s.die.file.string(), alpha, seeds, 2 * diameter / std::cbrt(double(seeds)), 2 * diameter);
 }
 
 std::vector<PlanOption> options_of(const scene::PipelineScene& s, const std::vector<PlanLevel>& levels, const PlanRequest& r) {
   std::vector<PlanOption> out;
-  const double a = r.accuracy, target = s.particle_diameter;
+  const double a = r.accuracy, target = s.powder.particle_diameter;
   for (const PlanLevel& l : levels) {
     if (!l.affine) continue;  // its bias is not known
     PlanOption o;
@@ -94,7 +94,7 @@ std::vector<PlanOption> options_of(const scene::PipelineScene& s, const std::vec
     while (o.seeds < 8 && ladder_stderr(ladder, o.seeds, target) > a) ++o.seeds;
     o.stderr_ = ladder_stderr(ladder, o.seeds, target);
     for (const PlanLevel* l : ladder) o.predicted_s += o.seeds * l->predicted_s;
-    o.command = fmt::format("diefill run {} --ladder {} --seeds {}", s.die.string(), fmt::join(o.alphas, ","), o.seeds);
+    o.command = fmt::format("diefill run {} --ladder {} --seeds {}", s.die.file.string(), fmt::join(o.alphas, ","), o.seeds);
     out.push_back(o);
   }
   for (PlanOption& o : out) o.meets_accuracy = o.stderr_ <= a, o.within_budget = o.predicted_s <= r.budget_s;
@@ -123,31 +123,31 @@ Plan make_plan(const scene::PipelineScene& scene, const PlanRequest& request) {
                               "Give one in (0, 0.5), e.g. 0.01");
   Plan plan;
   plan.request = request;
-  const DieSource die = read_die(scene, scene.die);
+  const DieSource die = read_die(scene.die, scene.die.file);
   plan.die = die.file.name;
-  const ShoePlan shoe = plan_shoe(scene, die);
+  const ShoePlan shoe = plan_shoe(scene.shoe, scene.motion, die);
   const mesh::Box box = mesh::bounding_box(die.file.mesh);
   const mesh::FeatureWidths widths =
       mesh::feature_widths(die.file.mesh, die.table_z, std::max(box.size().minCoeff() / 16, std::cbrt(box.size().prod() / 5e5)));
   plan.narrowest_feature_m = narrowest_tenth(widths);
   const double volume = widths.cavity_volume, walls = wall_area(die.file.mesh, die.table_z);
-  const fs::path cache = scene.cache.empty() ? scene.out / ".cache" : scene.cache;
-  plan.kernel_rate = kernel_rate(scene, size_grains(scene, shoe, plan.die), cache);
+  const fs::path cache = scene.output.cache.empty() ? scene.output.directory / ".cache" : scene.output.cache;
+  plan.kernel_rate = kernel_rate(scene, size_grains(scene.powder, scene.shoe.fill_height, shoe, plan.die), cache);
   const TimeModel model = time_model(cache, plan.kernel_rate);
   plan.timed_runs = model.runs;
   plan.machine = machine_key(scene.threads > 0 ? scene.threads : omp_get_max_threads());
   for (const double alpha : alpha_grid()) {
     scene::PipelineScene s = scene;
-    s.coarse_graining = alpha;
-    s.max_grains = std::numeric_limits<std::size_t>::max() / 2;  // the plan sees the grains a size needs
+    s.powder.coarse_graining = alpha;
+    s.powder.max_grains = std::numeric_limits<std::size_t>::max() / 2;  // the plan sees the grains a size needs
     PlanLevel l;
     l.alpha = alpha;
-    const GrainSizing grains = size_grains(s, shoe, plan.die);
+    const GrainSizing grains = size_grains(s.powder, s.shoe.fill_height, shoe, plan.die);
     l.diameter_m = grains.diameter;
     l.grains_across = plan.narrowest_feature_m / grains.diameter;
     if (l.grains_across < 1) continue;  // no grain enters
     ShoePlan raised = shoe;
-    set_clearance(s, grains, die.table_z, raised);
+    set_clearance(s.shoe.clearance, grains, die.table_z, raised);
     try {
       l.size = preflight(s, die, raised, grains);
     } catch (const diefill::InputError& e) {
@@ -158,13 +158,36 @@ Plan make_plan(const scene::PipelineScene& scene, const PlanRequest& request) {
     l.predicted_s = model.predict(l.particle_steps, plan.kernel_rate);
     l.grains_in_cavity = typical_fill * volume / (std::numbers::pi / 6 * std::pow(l.diameter_m, 3));
     l.seed_stderr = seed_noise / std::sqrt(l.grains_in_cavity);
-    l.bias = typical_fill * wall_layer * walls / volume * (l.diameter_m - scene.particle_diameter);
+    l.bias = typical_fill * wall_layer * walls / volume * (l.diameter_m - scene.powder.particle_diameter);
     l.affine = l.grains_across >= grains_across_needed;
     plan.levels.push_back(l);
   }
   plan.options = options_of(scene, plan.levels, request);
   plan.chosen = choose(plan.options);
   return plan;
+}
+
+PlannedRun planned_run(const Plan& plan, const scene::PipelineScene& scene) {
+  const PlanOption& chosen = plan.options.at(*plan.chosen);
+  PlannedRun run;
+  // The plan sized each grain size without the grain budget: the run may take what it chose.
+  std::size_t grains = scene.powder.max_grains;
+  for (const PlanLevel& l : plan.levels)
+    if (std::find(chosen.alphas.begin(), chosen.alphas.end(), l.alpha) != chosen.alphas.end()) grains = std::max(grains, l.size.grains + 1);
+  run.overrides.push_back(fmt::format("powder.max_grains={}", grains));
+  run.seeds = chosen.seeds;
+  if (chosen.kind == "ladder") {
+    run.ladder = fmt::format("{}", fmt::join(chosen.alphas, ","));
+    return run;
+  }
+  run.overrides.push_back(fmt::format("powder.coarse_graining={}", chosen.alphas.front()));
+  if (chosen.seeds > 1) {
+    // As its command says: finer voxels for the seeds (single_command).
+    const double d = chosen.alphas.front() * scene.powder.particle_diameter;
+    run.overrides.push_back(fmt::format("density.voxel={:.3g}", 2 * d / std::cbrt(double(chosen.seeds))));
+    run.overrides.push_back(fmt::format("fem.element_size={:.3g}", 2 * d));
+  }
+  return run;
 }
 
 nlohmann::json plan_json(const Plan& p) {

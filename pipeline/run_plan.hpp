@@ -59,6 +59,16 @@ struct Plan {
 // Plans the scene's die (refused as `diefill run` would refuse it).
 Plan make_plan(const scene::PipelineScene& scene, const PlanRequest& request);
 nlohmann::json plan_json(const Plan& plan);
+
+// The plan's chosen way as `diefill run` runs it: the settings to add to the scene's (its grain
+// size, a grain budget that lets the chosen sizes run, the seeds' finer voxels) and, for a
+// ladder, its levels; the seeds of an ensemble or of each level.
+struct PlannedRun {
+  std::vector<std::string> overrides;
+  std::optional<std::string> ladder;  // "A1,A2,A3"
+  int seeds = 1;
+};
+PlannedRun planned_run(const Plan& plan, const scene::PipelineScene& scene);
 std::string plan_table(const Plan& plan);
 
 // "90", "90s", "30m", "2h", "1h30m": seconds; InputError naming --budget otherwise.

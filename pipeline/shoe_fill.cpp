@@ -59,10 +59,10 @@ Bed bed_of(const Insertion& in, const dem::State& bed) {
 // the poured 0.6): grains dropped from no higher than that cannot be thrown out of the shoe.
 dem::InsertRegion space_above_bed(const Insertion& in, const Bed& bed, std::size_t count) {
   const double inset = in.grains.r_max + 1e-6;
-  const double bed_height = bed.grains == 0 ? in.scene.fill_height
+  const double bed_height = bed.grains == 0 ? in.scene.shoe.fill_height
                                             : double(count) * std::numbers::pi / 6 * std::pow(in.grains.diameter, 3) /
                                                   (0.6 * in.shoe.length * in.shoe.width);
-  const double top = std::min(in.table_z + in.scene.shoe_height - inset, bed.top + bed_height * 0.6 / 0.38 + 2 * in.grains.r_max);
+  const double top = std::min(in.table_z + in.scene.shoe.height - inset, bed.top + bed_height * 0.6 / 0.38 + 2 * in.grains.r_max);
   dem::InsertRegion region;
   region.box = {Vec3(in.shoe.x_start - 0.5 * in.shoe.length + inset, in.shoe.y_centre - 0.5 * in.shoe.width + inset, bed.top + inset),
                 Vec3(in.shoe.x_start + 0.5 * in.shoe.length - inset, in.shoe.y_centre + 0.5 * in.shoe.width - inset, top)};
@@ -82,7 +82,7 @@ std::size_t insert_round(const Insertion& in, dem::State& bed, std::size_t count
     dem::InsertRequest request;
     request.count = count;
     request.radius = 0.5 * in.grains.diameter;
-    request.radius_spread = in.scene.diameter_spread;
+    request.radius_spread = in.scene.powder.diameter_spread;
     request.material = in.walls.powder;
     request.density = density;
     request.seed = seed;
@@ -109,7 +109,7 @@ bool settle(const Insertion& in, dem::State& bed, const std::string& label, doub
   bed.step = 0;
   dem::initialize(model, bed);
   LoopOptions loop;
-  loop.until = in.scene.shoe_settle_time;
+  loop.until = in.scene.motion.shoe_settle_time;
   loop.label = label;
   loop.max_steps = in.scene.max_steps;
   const LoopResult result = run_until(model, bed, loop);
@@ -134,7 +134,7 @@ std::optional<SettledShoe> settle_afresh(const Insertion& in, const std::string&
   if (out.inserted < out.requested)
     diefill::log::warn("{}: the shoe holds {} of the {} grains that fill it to shoe.fill_height = {:.4g} mm; raise shoe.height or "
                        "lower shoe.fill_height",
-                       die_name, out.inserted, out.requested, in.scene.fill_height * 1e3);
+                       die_name, out.inserted, out.requested, in.scene.shoe.fill_height * 1e3);
   return out;
 }
 
@@ -175,8 +175,8 @@ std::optional<SettledShoe> fill_and_settle_shoe(const scene::PipelineScene& s, c
                                                 const ShoePlan& shoe, double table_z, const std::shared_ptr<dem::Exchange>& ranks) {
   Insertion in{s, walls, grains, shoe, table_z, std::nullopt, ranks};
   // Clumps are settled afresh each run: the particles file does not hold their poses.
-  if (!s.shape_mesh.empty()) {
-    in.clump = build_clump({s.shape_mesh, mesh::parse_unit(s.shape_units, "powder.shape.units"), s.shape_tolerance, 64, s.seed});
+  if (!s.powder.shape_mesh.empty()) {
+    in.clump = build_clump({s.powder.shape_mesh, s.powder.shape_units, s.powder.shape_tolerance, 64, s.seed});
     if (ranks) expect_same_template_on_every_rank(*in.clump, *ranks);
     std::optional<SettledShoe> settled = settle_afresh(in, walls.die.name);
     if (settled) rest(settled->state);

@@ -93,7 +93,7 @@ OutputsSoFar load_outputs(const fs::path& checkpoint, double origin, std::uint64
 std::optional<FillResult> move_shoe(const scene::PipelineScene& s, const FillWalls& walls, const ShoePlan& shoe, double table_z,
                                     dem::State settled, const fs::path& dir, bool resume) {
   dem::ModelSpec spec = walls.spec;
-  spec.meshes[1].motion = shoe.motion;
+  spec.meshes[walls.shoe_wall].motion = shoe.motion;
   FillResult fill{std::move(settled), {}, 0, {}};
   dem::State& state = fill.state;
   const dem::Model model = dem::compile_model(spec, state, s.source);
@@ -106,14 +106,14 @@ std::optional<FillResult> move_shoe(const scene::PipelineScene& s, const FillWal
   std::vector<double>& snapshot_times = so_far.snapshot_times;
   const mesh::TriMesh shoe_surface = surface_of(*walls.shoe_field);
   LoopOptions loop;
-  loop.until = shoe.t_motion + s.die_settle_time;
+  loop.until = shoe.t_motion + s.motion.die_settle_time;
   loop.max_steps = s.max_steps;
   loop.label = walls.die.name + ": filling";
   loop.checkpoint = checkpoint;
   loop.resumed = resumed;
   loop.output_origin = so_far.origin;
-  if (s.snapshot_every > 0)
-    loop.outputs.push_back({s.snapshot_every, [&](const dem::State& st) {
+  if (s.output.snapshot_every > 0)
+    loop.outputs.push_back({s.output.snapshot_every, [&](const dem::State& st) {
                               const std::size_t k = snapshot_times.size();
                               snapshot_times.push_back(st.time);
                               dem::with_whole_state(st, [&](const dem::State& whole) {
@@ -122,7 +122,7 @@ std::optional<FillResult> move_shoe(const scene::PipelineScene& s, const FillWal
                               });
                             }});
   const double density = walls.spec.materials[std::size_t(walls.powder)].density;
-  loop.outputs.push_back({s.fill_curve_every, [&](const dem::State& st) { fill.curve.push_back(sample_fill(st, table_z, density, shoe)); }});
+  loop.outputs.push_back({s.output.fill_curve_every, [&](const dem::State& st) { fill.curve.push_back(sample_fill(st, table_z, density, shoe)); }});
   loop.detail = [&](const dem::State& st) {
     std::size_t n = 0;
     for (std::size_t i = 0; i < st.owned(); ++i) n += st.active[i] && st.body[i] < 0 && st.x[i].z() < table_z;

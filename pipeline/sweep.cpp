@@ -39,15 +39,15 @@ std::vector<DieRun> run_sweep(const std::function<scene::PipelineScene(const std
       throw diefill::InputError("--sweep", sweep.key, "value '" + value + "' would name a folder inside another", "Give plain values");
     scenes.push_back(load({sweep.key + "=" + value}));
   }
-  const fs::path base = scenes.front().out;
+  const fs::path base = scenes.front().output.directory;
   std::vector<DieRun> runs;
   for (std::size_t k = 0; k < scenes.size(); ++k) {
     scene::PipelineScene& scene = scenes[k];
-    if (scene.cache.empty()) scene.cache = base / ".cache";  // one settled shoe for every case it fits
-    scene.out = base / (sweep.key + "=" + sweep.values[k]);
+    if (scene.output.cache.empty()) scene.output.cache = base / ".cache";  // one settled shoe for every case it fits
+    scene.output.directory = base / (sweep.key + "=" + sweep.values[k]);
     // Rank 0 writes the outputs after the others have finished the case: should that fail, every
     // rank must learn of it before the next case's collective steps.
-    dem::run_and_agree(ranks.get(), true, [&] { runs.push_back(run_die_fill(scene, scene.die, false, ranks)); });
+    dem::run_and_agree(ranks.get(), true, [&] { runs.push_back(run_die_fill(scene, scene.die.file, false, ranks)); });
     if (runs.back().interrupted) return runs;
   }
   if (ranks && ranks->rank() != 0) return runs;

@@ -58,7 +58,7 @@ double measure_kernel(const scene::PipelineScene& s, const GrainSizing& grains) 
   request.count = 4000;
   request.max_solid_fraction = 0.45;
   request.radius = 0.5 * d;
-  request.radius_spread = s.diameter_spread;
+  request.radius_spread = s.powder.diameter_spread;
   request.material = powder;
   request.density = spec.materials[std::size_t(powder)].density;
   dem::insert_spheres(state, region, request);

@@ -21,17 +21,17 @@ namespace {
 // as the shoe's travel and as wide as the shoe, plus a margin.
 mesh::DieOptions die_options(const scene::PipelineScene& s, const GrainSizing& grains, const ShoePlan& shoe, const DieSource& source) {
   const double r = grains.r_max;
-  mesh::DieOptions o = mesh::die_options_for_grains(r, 0.5 * r, s.die_voxel_fraction * r);
+  mesh::DieOptions o = mesh::die_options_for_grains(r, 0.5 * r, s.die.voxel_fraction * r);
   o.unit = source.file.unit;
   o.up = source.file.up;
   o.role = mesh::WallRole::cavity;
   // Room beside the shoe: grains that pass under its walls (the strike-off) stay on the table
   // rather than falling off a table the size of the shoe (two radii let one grain in 2000 off).
   const double margin = 2e-3 + 6 * r;
-  o.table = mesh::TableExtent{shoe.x_start - 0.5 * shoe.length - s.shoe_wall - margin,
-                              shoe.y_centre - 0.5 * shoe.width - s.shoe_wall - margin,
-                              shoe.x_end + 0.5 * shoe.length + s.shoe_wall + margin,
-                              shoe.y_centre + 0.5 * shoe.width + s.shoe_wall + margin, 2e-3};
+  o.table = mesh::TableExtent{shoe.x_start - 0.5 * shoe.length - s.shoe.wall - margin,
+                              shoe.y_centre - 0.5 * shoe.width - s.shoe.wall - margin,
+                              shoe.x_end + 0.5 * shoe.length + s.shoe.wall + margin,
+                              shoe.y_centre + 0.5 * shoe.width + s.shoe.wall + margin, 2e-3};
   return o;
 }
 
@@ -41,13 +41,13 @@ mesh::DieOptions die_options(const scene::PipelineScene& s, const GrainSizing& g
 std::shared_ptr<const mesh::WallField> shoe_field(const scene::PipelineScene& s, const GrainSizing& grains, const ShoePlan& shoe,
                                                   mesh::LengthUnit unit, const std::filesystem::path& cache) {
   const double r = grains.r_max;
-  if (s.shoe_mesh.empty())
+  if (s.shoe.mesh.empty())
     return std::make_shared<const mesh::WallField>(
-        mesh::contact_wall_field(mesh::shoe_solid(shoe.length, shoe.width, s.shoe_height, s.shoe_wall), r));
+        mesh::contact_wall_field(mesh::shoe_solid(shoe.length, shoe.width, s.shoe.height, s.shoe.wall), r));
   mesh::DieOptions o = mesh::die_options_for_grains(r, 0.5 * r, 0.5 * r);
   o.unit = unit;
   o.role = mesh::WallRole::tool;
-  const mesh::PreparedDie prepared = mesh::prepare_die(s.shoe_mesh, o, cache);
+  const mesh::PreparedDie prepared = mesh::prepare_die(s.shoe.mesh, o, cache);
   return std::make_shared<const mesh::WallField>(prepared.sdf.wall_field(prepared.solid));
 }
 
@@ -68,12 +68,14 @@ void check_grains_enter(const FillWalls& w, const DieSource& source, const Grain
                        w.die.name, 2 * inscribed * 1e3, grains.diameter * 1e3);
 }
 
-// The coarse-grained laws with the die and the shoe as walls, inside the table's extent.
-dem::ModelSpec fill_spec(const scene::PipelineScene& s, const FillWalls& w, const DieSource& source, const GrainSizing& grains,
+// The coarse-grained laws with the die and the shoe as walls, inside the table's extent; the
+// walls' places recorded in `w`.
+dem::ModelSpec fill_spec(const scene::PipelineScene& s, FillWalls& w, const DieSource& source, const GrainSizing& grains,
                          const ShoePlan& shoe, const mesh::TableExtent& table) {
   dem::ModelSpec spec = fill_laws(s, grains, source.box.size().z());
   spec.domain = {Vec3(table.x_min, table.y_min, source.box.lo.z() - 1e-3),
-                 Vec3(table.x_max, table.y_max, source.table_z + s.shoe_height + 5e-3)};
+                 Vec3(table.x_max, table.y_max, source.table_z + s.shoe.height + 5e-3)};
+  w.die_wall = spec.meshes.size();
   spec.meshes.push_back(dem::fixed_mesh_wall(w.die_field, w.steel, "die"));
   dem::MeshWall shoe_wall = dem::fixed_mesh_wall(w.shoe_field, w.steel, "shoe");
   shoe_wall.motion.start_position = shoe.motion.start_position;
@@ -84,6 +86,7 @@ dem::ModelSpec fill_spec(const scene::PipelineScene& s, const FillWalls& w, cons
   shoe_wall.cut_fraction = 1 - 0.5 * spec.stop_overlap;
   // A pinched pair overlaps about twice as deep as the wall presses (model.hpp): at half the stop limit.
   shoe_wall.cut_cap = 0.25 * spec.stop_overlap;
+  w.shoe_wall = spec.meshes.size();
   spec.meshes.push_back(shoe_wall);
   return spec;
 }
@@ -114,7 +117,7 @@ FillWalls prepare_walls(const scene::PipelineScene& s, const DieSource& source, 
   FillWalls w;
   w.powder = scene::powder_material(s.spec);
   w.steel = scene::tool_material(s.spec);
-  w.cache = s.cache.empty() ? s.out / ".cache" : s.cache;
+  w.cache = s.output.cache.empty() ? s.output.directory / ".cache" : s.output.cache;
   const mesh::DieOptions options = die_options(s, grains, shoe, source);
   w.die = mesh::prepare_die(source.file, options, w.cache);
   for (const std::string& action : w.die.actions) diefill::log::info("{}: {}", source.file.name, action);

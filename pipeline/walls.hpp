@@ -14,6 +14,7 @@ struct FillWalls {
   mesh::PreparedDie die;
   std::shared_ptr<const mesh::WallField> die_field, shoe_field;
   dem::ModelSpec spec;  // laws for the sized grains, gravity, the domain, walls "die" and "shoe"
+  std::size_t die_wall = 0, shoe_wall = 0;  // their places in spec.meshes
   int powder = 0, steel = 0;  // material indices
   std::filesystem::path cache;  // OUT/.cache
 };

@@ -15,34 +15,75 @@ namespace {
 using P = PipelineScene;
 using K = SceneKey<P>;
 
+// The value a key reads and writes, as a reference from the scene: in the settings of its table's
+// stage (s.*group.*m), or the scene's own (s.*m).
+template <class Group, class T>
+auto member(Group P::*group, T Group::*m) {
+  return [group, m](auto& s) -> auto& { return s.*group.*m; };
+}
+template <class T>
+auto member(T P::*m) {
+  return [m](auto& s) -> auto& { return s.*m; };
+}
+
+template <class Member>
 K number(std::string_view table, std::string_view name, std::string_view unit, ValueRange range, Shapes shapes,
-         std::string_view meaning, double P::*member) {
+         std::string_view meaning, Member f) {
   return {table, name, KeyType::number, unit, range, {}, shapes, meaning,
-          [member](const P& s) -> KeyValue { return s.*member; },
-          [member](P& s, const KeyValue& v) { s.*member = std::get<double>(v); }};
+          [f](const P& s) -> KeyValue { return double(f(s)); },
+          [f](P& s, const KeyValue& v) { f(s) = std::get<double>(v); }};
 }
 
-template <class Integer>
-K integer(std::string_view table, std::string_view name, ValueRange range, Shapes shapes, std::string_view meaning,
-          Integer P::*member) {
+template <class Member>
+K integer(std::string_view table, std::string_view name, ValueRange range, Shapes shapes, std::string_view meaning, Member f) {
   return {table, name, KeyType::integer, "", range, {}, shapes, meaning,
-          [member](const P& s) -> KeyValue { return double(s.*member); },
-          [member](P& s, const KeyValue& v) { s.*member = Integer(std::get<double>(v)); }};
+          [f](const P& s) -> KeyValue { return double(f(s)); },
+          [f](P& s, const KeyValue& v) { f(s) = std::remove_reference_t<decltype(f(s))>(std::get<double>(v)); }};
 }
 
-K flag(std::string_view table, std::string_view name, Shapes shapes, std::string_view meaning, bool P::*member) {
+template <class Member>
+K flag(std::string_view table, std::string_view name, Shapes shapes, std::string_view meaning, Member f) {
   return {table, name, KeyType::boolean, "", {}, {}, shapes, meaning,
-          [member](const P& s) -> KeyValue { return s.*member; },
-          [member](P& s, const KeyValue& v) { s.*member = std::get<bool>(v); }};
+          [f](const P& s) -> KeyValue { return bool(f(s)); },
+          [f](P& s, const KeyValue& v) { f(s) = std::get<bool>(v); }};
 }
 
-template <class Text>
-K text(std::string_view table, std::string_view name, KeyType type, std::vector<std::string_view> choices, Shapes shapes,
-       std::string_view meaning, Text P::*member) {
-  return {table, name, type, "", {}, std::move(choices), shapes, meaning,
-          [member](const P& s) -> KeyValue { return std::filesystem::path(s.*member).string(); },
-          [member](P& s, const KeyValue& v) { s.*member = Text(std::get<std::string>(v)); }};
+template <class Member>
+K text(std::string_view table, std::string_view name, KeyType type, Shapes shapes, std::string_view meaning, Member f) {
+  return {table, name, type, "", {}, {}, shapes, meaning,
+          [f](const P& s) -> KeyValue { return std::filesystem::path(f(s)).string(); },
+          [f](P& s, const KeyValue& v) { f(s) = std::remove_reference_t<decltype(f(s))>(std::get<std::string>(v)); }};
 }
+
+// A choice read into the enum (or unit, or direction) of the stage that acts on it: the scene's
+// text is checked against the choices once, at load, and no stage parses it again.
+template <class Value, class Member>
+K choice(std::string_view table, std::string_view name, std::vector<std::pair<std::string_view, Value>> options, Shapes shapes,
+         std::string_view meaning, Member f) {
+  std::vector<std::string_view> texts;
+  for (const auto& option : options) texts.push_back(option.first);
+  return {table, name, KeyType::choice, "", {}, std::move(texts), shapes, meaning,
+          [f, options](const P& s) -> KeyValue {
+            for (const auto& [text, value] : options)
+              if (value == f(s)) return std::string(text);
+            throw std::logic_error("a scene choice holds a value its key does not list");
+          },
+          [f, options](P& s, const KeyValue& v) {
+            for (const auto& [text, value] : options)
+              if (text == std::get<std::string>(v)) f(s) = value;
+          }};
+}
+
+template <class Value, std::size_t N>
+std::vector<std::pair<std::string_view, Value>> options_of(const std::array<std::pair<std::string_view, Value>, N>& table) {
+  return {table.begin(), table.end()};
+}
+
+const std::vector<std::pair<std::string_view, std::optional<mesh::LengthUnit>>> unit_or_auto = {
+    {"auto", std::nullopt}, {"mm", mesh::LengthUnit::mm}, {"m", mesh::LengthUnit::m}, {"in", mesh::LengthUnit::in}};
+const std::vector<std::pair<std::string_view, std::optional<mesh::Up>>> up_choices = {
+    {"auto", std::nullopt}, {"+z", mesh::Up{2, 1}}, {"-z", mesh::Up{2, -1}}, {"+x", mesh::Up{0, 1}},
+    {"-x", mesh::Up{0, -1}}, {"+y", mesh::Up{1, 1}}, {"-y", mesh::Up{1, -1}}};
 
 dem::ModelSpec& spec_of(P& s) { return s.spec; }
 
@@ -51,101 +92,101 @@ constexpr double metre_range_hi = 1.0;  // the die table is a desk, not a quarry
 KeyTable<P> make_pipeline_keys() {
   const Shapes die = Shapes::die, settling = Shapes::settling, run = Shapes::run, nothing = Shapes::nothing;
   KeyTable<P> k = {
-      text("die", "file", KeyType::path, {}, die, "the die's cavity mesh (relative to the scene file)", &P::die),
-      text("die", "units", KeyType::choice, {"auto", "mm", "m", "in"}, die,
+      text("die", "file", KeyType::path, die, "the die's cavity mesh (relative to the scene file)", member(&P::die, &DieSettings::file)),
+      choice("die", "units", unit_or_auto, die,
            "the mesh file's length unit (files store none); auto: guessed from its size, 3 or more across mm, 1 to 3 "
            "inches, under 1 metres (a warning says so unless mm)",
-           &P::die_units),
-      text("die", "up", KeyType::choice, {"auto", "+z", "-z", "+x", "-x", "+y", "-y"}, die,
+           member(&P::die, &DieSettings::units)),
+      choice("die", "up", up_choices, die,
            "the way the cavity's opening faces in the file; the die is turned so that it faces up (+z). auto: +z "
            "when the flat faces at the top cover half of the part's outline seen from above, else the extreme whose "
            "flat faces cover the largest share of the outline along their axis",
-           &P::die_up),
-      text("die", "parting", KeyType::choice, {"auto", "opening", "widest"}, die,
+           member(&P::die, &DieSettings::up)),
+      choice<mesh::Parting>("die", "parting", {{"auto", mesh::Parting::automatic}, {"opening", mesh::Parting::opening}, {"widest", mesh::Parting::widest}}, die,
            "where the die table meets the part: opening, at its flat face (a part with none is refused); widest, at "
            "its widest section across the up axis, the cavity being the part below (the upper punch forms the "
            "rest); auto: opening when the part has a flat face at an extreme, else widest with the part lying flat "
            "(up: the axis of its largest outline)",
-           &P::die_parting),
+           member(&P::die, &DieSettings::parting)),
       integer("die", "part", {0, 1e6}, die,
               "for a file that holds an assembly (bodies that share no vertex): the body the die is for, numbered by "
               "enclosed volume, largest first; 0: the whole file as one part",
-              &P::die_part),
-      text("die", "role", KeyType::choice, {"cavity"}, die,
+              member(&P::die, &DieSettings::part)),
+      choice<mesh::WallRole>("die", "role", {{"cavity", mesh::WallRole::cavity}}, die,
            "the mesh is the part's shape, open at the die table (its highest z); `diefill sdf --role` takes tools too",
-           &P::die_role),
+           member(&P::die, &DieSettings::role)),
       number("die", "voxel_fraction", "largest grain radii", {0.05, 4}, die,
              "SDF voxel edge: contacts are exact either way, finer voxels find them faster near curved walls",
-             &P::die_voxel_fraction),
-      number("shoe", "length", "m", {5e-3, metre_range_hi}, settling, "inside, along the motion (x)", &P::shoe_length),
-      number("shoe", "width", "m", {5e-3, metre_range_hi}, settling, "inside, across the motion (y)", &P::shoe_width),
-      number("shoe", "height", "m", {2e-3, metre_range_hi}, settling, "inside", &P::shoe_height),
-      number("shoe", "wall_thickness", "m", {5e-4, 0.05}, settling, "of the box shoe's walls", &P::shoe_wall),
+             member(&P::die, &DieSettings::voxel_fraction)),
+      number("shoe", "length", "m", {5e-3, metre_range_hi}, settling, "inside, along the motion (x)", member(&P::shoe, &ShoeSettings::length)),
+      number("shoe", "width", "m", {5e-3, metre_range_hi}, settling, "inside, across the motion (y)", member(&P::shoe, &ShoeSettings::width)),
+      number("shoe", "height", "m", {2e-3, metre_range_hi}, settling, "inside", member(&P::shoe, &ShoeSettings::height)),
+      number("shoe", "wall_thickness", "m", {5e-4, 0.05}, settling, "of the box shoe's walls", member(&P::shoe, &ShoeSettings::wall)),
       number("shoe", "fill_height", "m", {1e-3, metre_range_hi}, settling,
              "powder bed in the shoe: three times what the ring takes; outflow does not depend on the head (Beverloo)",
-             &P::fill_height),
+             member(&P::shoe, &ShoeSettings::fill_height)),
       number("shoe", "clearance", "largest grain radii", {0, 10}, settling,
              "gap under the walls; the shoe strikes off at the table: lower pinches grains, higher lets them escape",
-             &P::clearance),
-      flag("shoe", "trim_width", settling, "simulate only the shoe's width over the die plus side_margin", &P::trim_width),
-      number("shoe", "side_margin", "m", {0, 0.1}, settling, "kept on each side of the die when trimming", &P::side_margin),
-      text("shoe", "mesh", KeyType::path, {}, settling, "a shoe mesh instead of the box (origin at its inner centre, on the table)",
-           &P::shoe_mesh),
-      number("motion", "speed", "m/s", {1e-3, 10}, run, "cruise speed of the shoe over the die", &P::speed),
-      number("motion", "acceleration", "m/s²", {0.1, 1000}, run, "to and from the cruise speed", &P::acceleration),
+             member(&P::shoe, &ShoeSettings::clearance)),
+      flag("shoe", "trim_width", settling, "simulate only the shoe's width over the die plus side_margin", member(&P::shoe, &ShoeSettings::trim_width)),
+      number("shoe", "side_margin", "m", {0, 0.1}, settling, "kept on each side of the die when trimming", member(&P::shoe, &ShoeSettings::side_margin)),
+      text("shoe", "mesh", KeyType::path, settling, "a shoe mesh instead of the box (origin at its inner centre, on the table)",
+           member(&P::shoe, &ShoeSettings::mesh)),
+      number("motion", "speed", "m/s", {1e-3, 10}, run, "cruise speed of the shoe over the die", member(&P::motion, &MotionSettings::speed)),
+      number("motion", "acceleration", "m/s²", {0.1, 1000}, run, "to and from the cruise speed", member(&P::motion, &MotionSettings::acceleration)),
       number("motion", "start_gap", "m", {0, metre_range_hi}, settling,
-             "leading wall before the die's edge at the start (where the shoe settles)", &P::start_gap),
+             "leading wall before the die's edge at the start (where the shoe settles)", member(&P::motion, &MotionSettings::start_gap)),
       number("motion", "end_gap", "m", {0, metre_range_hi}, run, "trailing wall past the die's far edge at a pass's end",
-             &P::end_gap),
-      number("motion", "dwell", "s", {0, 10}, run, "at the far end before returning", &P::dwell),
-      integer("motion", "passes", {1, 20}, run, "passes over the die", &P::passes),
-      flag("motion", "return", run, "the shoe comes back after each pass", &P::return_stroke),
+             member(&P::motion, &MotionSettings::end_gap)),
+      number("motion", "dwell", "s", {0, 10}, run, "at the far end before returning", member(&P::motion, &MotionSettings::dwell)),
+      integer("motion", "passes", {1, 20}, run, "passes over the die", member(&P::motion, &MotionSettings::passes)),
+      flag("motion", "return", run, "the shoe comes back after each pass", member(&P::motion, &MotionSettings::return_stroke)),
       number("motion", "shoe_settle_time", "s", zero_or(0.01, 2), settling, "the powder settles in the shoe before it moves (cached)",
-             &P::shoe_settle_time),
-      number("motion", "die_settle_time", "s", zero_or(1e-3, 2), run, "the die settles after the shoe has passed", &P::die_settle_time),
+             member(&P::motion, &MotionSettings::shoe_settle_time)),
+      number("motion", "die_settle_time", "s", zero_or(1e-3, 2), run, "the die settles after the shoe has passed", member(&P::motion, &MotionSettings::die_settle_time)),
       number("powder", "particle_diameter", "m", {1e-6, 5e-3}, settling, "the real powder: a free-flowing atomised metal",
-             &P::particle_diameter),
+             member(&P::powder, &PowderSettings::particle_diameter)),
       number("powder", "coarse_graining", "", {1, 200}, settling,
              "α: simulated grains α times the real ones; Hertz forces keep bulk behaviour (docs/PHYSICS.md §4)",
-             &P::coarse_graining),
+             member(&P::powder, &PowderSettings::coarse_graining)),
       number("powder", "diameter_spread", "", {0, 0.5}, settling,
-             "relative half-width of the uniform size distribution: ±10 % keeps the packing random", &P::diameter_spread),
+             "relative half-width of the uniform size distribution: ±10 % keeps the packing random", member(&P::powder, &PowderSettings::diameter_spread)),
       integer("powder", "max_grains", {100, 1e8}, settling, "larger α, with a warning, when the shoe would need more",
-              &P::max_grains),
-      text("powder.shape", "mesh", KeyType::path, {}, settling,
-           "a grain shape: rigid multi-sphere clumps scaled to the grain diameter (volume-equivalent)", &P::shape_mesh),
+              member(&P::powder, &PowderSettings::max_grains)),
+      text("powder.shape", "mesh", KeyType::path, settling,
+           "a grain shape: rigid multi-sphere clumps scaled to the grain diameter (volume-equivalent)", member(&P::powder, &PowderSettings::shape_mesh)),
       number("powder.shape", "tolerance", "", {0.01, 0.5}, settling, "the clump's volume and Hausdorff error",
-             &P::shape_tolerance),
-      text("powder.shape", "units", KeyType::choice, {"mm", "m", "in"}, settling, "the grain mesh's length unit",
-           &P::shape_units),
+             member(&P::powder, &PowderSettings::shape_tolerance)),
+      choice<mesh::LengthUnit>("powder.shape", "units", {{"mm", mesh::LengthUnit::mm}, {"m", mesh::LengthUnit::m}, {"in", mesh::LengthUnit::in}}, settling, "the grain mesh's length unit",
+           member(&P::powder, &PowderSettings::shape_units)),
   };
   add_physics_keys<P>(k, spec_of, settling);
   const auto physics_end = std::stable_partition(k.begin(), k.end(), [](const K& key) { return key.table != "simulation"; });
   KeyTable<P> simulation(physics_end, k.end());
   k.erase(physics_end, k.end());
   k.insert(k.end(), simulation.begin(), simulation.end());
-  k.push_back(integer("simulation", "seed", {0, 9007199254740991.0}, settling, "of the powder's random packing", &P::seed));
-  k.push_back(integer("simulation", "threads", {0, 4096}, nothing, "0: all cores; results do not depend on it", &P::threads));
-  k.push_back(number("density", "voxel", "m", zero_or(1e-5, 0.05), run, "0: two grain diameters", &P::density_voxel));
-  k.push_back(text("density", "method", KeyType::choice, {"exact", "gaussian"}, run,
-                   "exact volume split, or Gaussian coarse graining", &P::density_method));
+  k.push_back(integer("simulation", "seed", {0, 9007199254740991.0}, settling, "of the powder's random packing", member(&P::seed)));
+  k.push_back(integer("simulation", "threads", {0, 4096}, nothing, "0: all cores; results do not depend on it", member(&P::threads)));
+  k.push_back(number("density", "voxel", "m", zero_or(1e-5, 0.05), run, "0: two grain diameters", member(&P::density, &DensitySettings::voxel)));
+  k.push_back(choice("density", "method", options_of(density_methods), run,
+                   "exact volume split, or Gaussian coarse graining", member(&P::density, &DensitySettings::method)));
   k.push_back(number("density", "smoothed_width", "m", zero_or(1e-5, 0.05), run,
-                     "the smoothed field's Gaussian width and voxel; 0: half a grain diameter", &P::density_smoothed_width));
+                     "the smoothed field's Gaussian width and voxel; 0: half a grain diameter", member(&P::density, &DensitySettings::smoothed_width)));
   k.push_back(number("fem", "element_size", "m", zero_or(1e-4, 0.05), run,
-                     "the tetrahedra's largest edge in fem/fill.inp; 0: the density voxel", &P::fem_element_size));
-  k.push_back(text("fem", "elements", KeyType::choice, {"linear", "quadratic", "none"}, run,
-                   "C3D4, C3D10 with a node on every edge, or none: no FEM hand-off", &P::fem_elements));
-  k.push_back(text("fem", "compaction", KeyType::choice, {"calculix", "none"}, run,
-                   "the worked example: the fill pressed by a punch in CalculiX (fem/compaction.*)", &P::fem_compaction));
-  k.push_back(text("output", "directory", KeyType::text, {}, nothing, "each die writes into DIRECTORY/<die name>/ (relative "
-                   "to the working folder)", &P::out));
-  k.push_back(text("output", "cache", KeyType::text, {}, nothing, "prepared die fields and settled shoes, reused by runs "
-                   "that share them; empty: DIRECTORY/.cache", &P::cache));
+                     "the tetrahedra's largest edge in fem/fill.inp; 0: the density voxel", member(&P::fem, &FemSettings::element_size)));
+  k.push_back(choice("fem", "elements", options_of(fem_element_kinds), run,
+                   "C3D4, C3D10 with a node on every edge, or none: no FEM hand-off", member(&P::fem, &FemSettings::elements)));
+  k.push_back(choice("fem", "compaction", options_of(fem_compactions), run,
+                   "the worked example: the fill pressed by a punch in CalculiX (fem/compaction.*)", member(&P::fem, &FemSettings::compaction)));
+  k.push_back(text("output", "directory", KeyType::text, nothing, "each die writes into DIRECTORY/<die name>/ (relative "
+                   "to the working folder)", member(&P::output, &OutputSettings::directory)));
+  k.push_back(text("output", "cache", KeyType::text, nothing, "prepared die fields and settled shoes, reused by runs "
+                   "that share them; empty: DIRECTORY/.cache", member(&P::output, &OutputSettings::cache)));
   k.push_back(number("output", "snapshot_every", "s", zero_or(1e-3, 10), nothing, "VTU snapshots; 0: the final state only",
-                     &P::snapshot_every));
+                     member(&P::output, &OutputSettings::snapshot_every)));
   k.push_back(number("output", "fill_curve_every", "s", {1e-4, 1}, nothing,
                      "the fill curve's sampling (fill_curve.csv: mass in the cavity against time and the shoe's position)",
-                     &P::fill_curve_every));
+                     member(&P::output, &OutputSettings::fill_curve_every)));
   return k;
 }
 
@@ -213,9 +254,9 @@ PipelineScene load_pipeline_scene(const std::optional<std::filesystem::path>& sc
     if (std::optional<Table> t = root.table(table)) t->fail(key, problem, remedy);
     throw diefill::InputError(s.source, std::string(table) + "." + key, problem, remedy);
   };
-  if (s.fill_height > s.shoe_height) refuse("shoe", "fill_height", "is higher than the shoe", "Lower it below shoe.height");
+  if (s.shoe.fill_height > s.shoe.height) refuse("shoe", "fill_height", "is higher than the shoe", "Lower it below shoe.height");
   // Each pass starts where the last ended: without a return the shoe walks off the table.
-  if (s.passes > 1 && !s.return_stroke)
+  if (s.motion.passes > 1 && !s.motion.return_stroke)
     refuse("motion", "passes", "more than one pass needs motion.return = true", "Set motion.return = true, or one pass");
   if (!(s.spec.gravity.z() < 0))
     refuse("simulation", "gravity", "must point down (negative z): the powder falls into the die",

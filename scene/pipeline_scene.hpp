@@ -11,40 +11,88 @@
 #include <vector>
 
 #include "dem/model.hpp"
+#include "mesh/die.hpp"
+#include "scene/choices.hpp"
 #include "scene/scene_keys.hpp"
 
 namespace scene {
 
-struct PipelineScene {
-  std::string source = "(defaults)";  // the scene file, or the defaults
-  // [die]
-  std::filesystem::path die;  // mesh
-  std::string die_units = "auto";
-  std::string die_role = "cavity";
-  std::string die_up = "auto";
-  std::string die_parting = "auto";
-  int die_part = 0;  // the body of an assembly's file (mesh::DieFile::part); 0: the whole file
-  double die_voxel_fraction = 0.25;  // SDF voxel edge [largest grain radii] (mesh::default_voxel_fraction)
-  // [shoe] (metres)
-  double shoe_length = 32e-3, shoe_width = 50e-3, shoe_height = 37e-3, shoe_wall = 3e-3;
-  double fill_height = 8e-3;    // powder height in the shoe
-  double clearance = 1.0;       // gap between the shoe's walls and the die table [largest grain radii]
-  bool trim_width = true;       // simulate only the width over the die plus `side_margin`
+// The scene compiled: each table of the file read once into the typed settings of the stage that
+// reads it (choices as the enums of the module that acts on them), so that a stage receives its
+// own settings and not the whole scene.
+
+// [die] the die's mesh and how to read it (the mesh stage)
+struct DieSettings {
+  std::filesystem::path file;                 // the mesh
+  std::optional<mesh::LengthUnit> units;      // unset: guessed from the mesh's size
+  mesh::WallRole role = mesh::WallRole::cavity;
+  std::optional<mesh::Up> up;                 // unset: found (mesh::find_opening)
+  mesh::Parting parting = mesh::Parting::automatic;
+  int part = 0;                               // the body of an assembly's file (mesh::DieFile::part); 0: the whole file
+  double voxel_fraction = 0.25;               // SDF voxel edge [largest grain radii] (mesh::default_voxel_fraction)
+};
+
+// [shoe] the feeding shoe and the powder in it (metres)
+struct ShoeSettings {
+  double length = 32e-3, width = 50e-3, height = 37e-3, wall = 3e-3;
+  double fill_height = 8e-3;  // powder height in the shoe
+  double clearance = 1.0;     // gap between the shoe's walls and the die table [largest grain radii]
+  bool trim_width = true;     // simulate only the width over the die plus `side_margin`
   double side_margin = 4e-3;
-  std::string shoe_mesh;        // optional: a mesh for the shoe instead of the box
-  // [motion]
+  std::string mesh;           // optional: a mesh for the shoe instead of the box
+};
+
+// [motion] the shoe's strokes and the settling times
+struct MotionSettings {
   double speed = 0.1, acceleration = 2.0, start_gap = 2e-3, end_gap = 2e-3, dwell = 0.0;
   int passes = 1;
   bool return_stroke = false;
   double shoe_settle_time = 0.08, die_settle_time = 0.05;
-  // [powder]
+};
+
+// [powder] the real powder and its coarse graining
+struct PowderSettings {
   double particle_diameter = 0.1e-3;  // real powder [m]
   double coarse_graining = 8.0;       // α: simulated diameter = α × particle_diameter
   double diameter_spread = 0.1;       // relative half-width of the uniform size distribution
   std::size_t max_grains = 60000;     // coarser grains (larger α) beyond this, with a warning
   std::string shape_mesh;             // clumps (issue 6): a grain surface mesh
   double shape_tolerance = 0.05;
-  std::string shape_units = "mm";
+  mesh::LengthUnit shape_units = mesh::LengthUnit::mm;
+  double grain_diameter() const { return coarse_graining * particle_diameter; }
+};
+
+// [density] the density field binned from the grains (postprocess/density.hpp)
+struct DensitySettings {
+  double voxel = 0;           // [m]; 0: two grain diameters
+  DensityMethod method = DensityMethod::exact;
+  double smoothed_width = 0;  // [m]; 0: half a grain diameter
+};
+
+// [fem] the hand-off to compaction FEM (docs/INTERFACE.md, "FEM hand-off")
+struct FemSettings {
+  double element_size = 0;  // [m]; 0: the density voxel
+  FemElements elements = FemElements::linear;
+  FemCompaction compaction = FemCompaction::calculix;
+};
+
+// [output]
+struct OutputSettings {
+  std::filesystem::path directory = "out";
+  std::filesystem::path cache;    // empty: directory / ".cache"
+  double snapshot_every = 0;      // [s]; 0: final snapshot only
+  double fill_curve_every = 0.002;  // [s]
+};
+
+struct PipelineScene {
+  std::string source = "(defaults)";  // the scene file, or the defaults
+  DieSettings die;
+  ShoeSettings shoe;
+  MotionSettings motion;
+  PowderSettings powder;
+  DensitySettings density;
+  FemSettings fem;
+  OutputSettings output;
   // [materials], [contact], [simulation]
   dem::ModelSpec spec;                // materials "powder", "steel"; laws; gravity; time step
   std::uint64_t seed = 1;
@@ -52,22 +100,8 @@ struct PipelineScene {
   bool force = false;                 // `--force`: run a size over the limit (pipeline/preflight.hpp); no key
   std::int64_t max_steps = 0;         // a smoke run: every DEM stage ends after this many steps (the scene fuzz test); no key
   bool pictures = true;               // false: no PNGs (smoke runs, the studies' scratch runs nobody looks at); no key
-  // [density]
-  double density_voxel = 0;           // [m]; 0: two grain diameters
-  std::string density_method = "exact";
-  double density_smoothed_width = 0;  // [m]; 0: half a grain diameter
-  // [fem] the hand-off to compaction FEM (docs/INTERFACE.md, "FEM hand-off")
-  double fem_element_size = 0;        // [m]; 0: the density voxel
-  std::string fem_elements = "linear";        // "linear" (C3D4) | "quadratic" (C3D10) | "none" (no hand-off)
-  std::string fem_compaction = "calculix";    // "calculix": run the worked example | "none"
-  // [output]
-  std::filesystem::path out = "out";
-  std::filesystem::path cache;        // empty: out / ".cache"
-  double snapshot_every = 0;          // [s]; 0: final snapshot only
-  double fill_curve_every = 0.002;    // [s]
 
   PipelineScene();  // the defaults: materials "powder" and "steel", EPSD rolling, ...
-  double grain_diameter() const { return coarse_graining * particle_diameter; }
 };
 
 // Every key of the pipeline's scene but the [[materials]] and [[interactions]] entries

@@ -55,8 +55,8 @@ const KeyTable<S>& simulation_keys() {
   return keys;
 }
 
-const KeyTable<OutputSettings>& output_keys() {
-  using O = OutputSettings;
+const KeyTable<SimulationOutput>& output_keys() {
+  using O = SimulationOutput;
   static const KeyTable<O> keys = {
       value_key<O>("output", "directory", KeyType::text, "", {}, "relative to the working folder", &O::directory),
       value_key<O>("output", "trajectory", KeyType::boolean, "", {}, "particles CSV at every trajectory_every", &O::trajectory),

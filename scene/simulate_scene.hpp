@@ -12,7 +12,7 @@
 
 namespace scene {
 
-struct OutputSettings {
+struct SimulationOutput {
   std::filesystem::path directory = "out/simulation";
   bool trajectory = false;
   double trajectory_every = 1e-3;  // [s]
@@ -36,7 +36,7 @@ struct SimulationScene {
   double duration = 1e-3;  // [s]
   int threads = 0;         // 0: all cores
   std::uint64_t seed = 1;
-  OutputSettings output;
+  SimulationOutput output;
   std::vector<MeshWallEntry> mesh_walls;  // in the order of [[walls]]; spec.meshes is empty until they are built
 };
 

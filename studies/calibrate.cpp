@@ -34,13 +34,13 @@ double beverloo_orifice(double orifice, double d) {
 
 SimulatedTests simulated_tests(const scene::PipelineScene& scene, const MeasuredPowder& m, double orifice_grains) {
   scene::PipelineScene s = scene;
-  s.particle_diameter = m.particle_diameter;
-  s.diameter_spread = m.diameter_spread;
+  s.powder.particle_diameter = m.particle_diameter;
+  s.powder.diameter_spread = m.diameter_spread;
   s.spec.materials[std::size_t(scene::powder_material(s.spec))].density = m.material_density;
   // As coarse as keeps the orifice `orifice_grains` grains wide: Beverloo's k·d then corrects
   // the boundary (docs/PHYSICS.md §4), and every test holds the same few thousand grains
   // whatever the real powder's size.
-  s.coarse_graining = std::max(1.0, m.orifice_diameter / (orifice_grains * m.particle_diameter));
+  s.powder.coarse_graining = std::max(1.0, m.orifice_diameter / (orifice_grains * m.particle_diameter));
   SimulatedTests t{powder_of(s), orifice_grains, m.funnel_half_angle_deg};
   t.powder.source = m.source;
   return t;

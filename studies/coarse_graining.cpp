@@ -174,14 +174,14 @@ void drain_beds(FactorResult& f, const Powder& powder, const FactorSetup& setup,
 // The ring die filled by the pipeline at the factor's grain size: fill ratio, core fraction and wall layer.
 void fill_ring_die(FactorResult& f, scene::PipelineScene s, const Powder& powder, const scene::PipelineScene& scene,
                    const FactorSetup& setup, Output& out) {
-  s.out = out.work() / fmt::format("ring_alpha_{:.3g}", f.alpha);
-  s.fill_height = 5e-3;  // twice what the ring takes
-  s.side_margin = 2e-3;
+  s.output.directory = out.work() / fmt::format("ring_alpha_{:.3g}", f.alpha);
+  s.shoe.fill_height = 5e-3;  // twice what the ring takes
+  s.shoe.side_margin = 2e-3;
   const pipeline::DieRun ring = pipeline::run_die_fill(s, ring_mesh(out.work()), false);
   const dem::State fill = dem::read_particles(ring.dir / "particles.csv", 0, powder.density);
   f.fill_ratio = ring.report["fill"].value("fill_ratio", 0.0);
   f.cavity_grains = ring.report["particles"].value("in_cavity", std::size_t(0));
-  f.core_fraction = ring_core_solid_fraction(fill, setup.coarsest, 0.25 * scene.grain_diameter() * setup.z.relative_sizes.front());
+  f.core_fraction = ring_core_solid_fraction(fill, setup.coarsest, 0.25 * scene.powder.grain_diameter() * setup.z.relative_sizes.front());
   // A layer of thickness t empty and the rest at the core's fraction gives the mean fill.
   f.wall_layer = setup.ring.volume / setup.ring.surface * (1 - f.fill_ratio / f.core_fraction);
 }
@@ -190,16 +190,16 @@ FactorResult run_factor(const scene::PipelineScene& scene, double relative, cons
   diefill::Stopwatch clock;
   FactorResult f;
   scene::PipelineScene s = scene;
-  s.coarse_graining = scene.coarse_graining * relative;
-  f.alpha = s.coarse_graining;
-  f.diameter = s.grain_diameter();
+  s.powder.coarse_graining = scene.powder.coarse_graining * relative;
+  f.alpha = s.powder.coarse_graining;
+  f.diameter = s.powder.grain_diameter();
   const Powder powder = powder_of(s);
   const std::string label = fmt::format("coarse-graining: α = {:.3g} ({:.3g} mm)", f.alpha, f.diameter * 1e3);
 
   drain_beds(f, powder, setup, label);
   const SlotContainer& box = setup.box;
   // The rate the real powder would give by the Beverloo law, from this one's.
-  f.corrected_rate = f.rate * beverloo_slot(box.width, box.slot_width, beverloo_k, s.particle_diameter) /
+  f.corrected_rate = f.rate * beverloo_slot(box.width, box.slot_width, beverloo_k, s.powder.particle_diameter) /
                      beverloo_slot(box.width, box.slot_width, beverloo_k, f.diameter);
 
   if (setup.fill_ring) fill_ring_die(f, s, powder, scene, setup, out);
@@ -339,7 +339,7 @@ nlohmann::json coarse_graining_results(const std::vector<FactorResult>& results,
 void coarse_graining(const scene::PipelineScene& scene_in, bool reduced, Output& out) {
   const CoarseGrainingSizes z = coarse_graining_sizes(reduced);
   const scene::PipelineScene scene = affordable(scene_in);
-  const double coarsest = scene.grain_diameter() * z.relative_sizes.back();
+  const double coarsest = scene.powder.grain_diameter() * z.relative_sizes.back();
   // Reduced, the ring is not filled: 0.8-1.6 mm grains are 3 to 6 across its annulus, far from
   // the 20 that docs/PHYSICS.md §4 asks for, so their fill tests no invariance (the pipeline tests
   // fill it); the slot container scales with the grains and is the whole reduced study.
@@ -347,7 +347,7 @@ void coarse_graining(const scene::PipelineScene& scene_in, bool reduced, Output&
 
   std::vector<FactorResult> results;
   for (double relative : z.relative_sizes) results.push_back(run_factor(scene, relative, setup, out));
-  const Comparison comparison = compare_factors(results, setup.box, setup.ring, scene.particle_diameter);
+  const Comparison comparison = compare_factors(results, setup.box, setup.ring, scene.powder.particle_diameter);
 
   write_factors_table(results, setup.fill_ring, out);
   chart_invariance(results, comparison, setup.fill_ring, out);

@@ -257,19 +257,19 @@ ShoeRuns run_moving_shoe(const scene::PipelineScene& scene, const DischargeSizes
   ShoeRuns shoe;
   for (double v : z.speeds) {
     scene::PipelineScene s = scene;
-    s.die_units = "mm";
-    s.speed = v;
-    s.acceleration = 10;  // about 1 g: the shoe reaches its speed before the opening
-    s.start_gap = v * v / (2 * s.acceleration) + 2e-3;
-    s.fill_height = z.shoe_fill * die.shoe_d;
-    s.coarse_graining = scene.coarse_graining * z.shoe_coarsening;
-    s.out = out.work() / fmt::format("shoe_{:.3f}_m_s", v);
+    s.die.units = mesh::LengthUnit::mm;
+    s.motion.speed = v;
+    s.motion.acceleration = 10;  // about 1 g: the shoe reaches its speed before the opening
+    s.motion.start_gap = v * v / (2 * s.motion.acceleration) + 2e-3;
+    s.shoe.fill_height = z.shoe_fill * die.shoe_d;
+    s.powder.coarse_graining = scene.powder.coarse_graining * z.shoe_coarsening;
+    s.output.directory = out.work() / fmt::format("shoe_{:.3f}_m_s", v);
     const pipeline::DieRun run = pipeline::run_die_fill(s, die.bin, false);
     const double mass = run.report["fill"].value("mass_kg", 0.0);
     shoe.speeds.push_back(v);
     shoe.delivered.push_back(mass);
-    shoe.law_error.push_back(mass / law_mass(law, die, scene.shoe_length, v) - 1);
-    shoe.rows.push_back({v, mass, mass / die.capacity, law_mass(law, die, scene.shoe_length, v)});
+    shoe.law_error.push_back(mass / law_mass(law, die, scene.shoe.length, v) - 1);
+    shoe.rows.push_back({v, mass, mass / die.capacity, law_mass(law, die, scene.shoe.length, v)});
   }
   return shoe;
 }
@@ -364,12 +364,12 @@ void discharge(const scene::PipelineScene& scene, bool reduced, Output& out) {
   const ShoeRuns shoe = run_moving_shoe(scene, z, law, die, out);
   const CriticalVelocity critical = fit_critical_velocity(shoe, die.capacity);
   out.table("moving_shoe.csv", {"speed_m_s", "delivered_kg", "fill_ratio", "moving_container_law_kg"}, shoe.rows);
-  chart_moving_shoe(shoe, critical, law, die, scene.shoe_length, out);
+  chart_moving_shoe(shoe, critical, law, die, scene.shoe.length, out);
 
   out.results = {{"grain_diameter_m", d},
                  {"shoe_grain_diameter_m", die.shoe_d},
                  {"slot", slot_results(slot, law, z)},
-                 {"moving_shoe", moving_shoe_results(shoe, critical, die, scene.shoe_length)}};
+                 {"moving_shoe", moving_shoe_results(shoe, critical, die, scene.shoe.length)}};
 }
 
 }  // namespace studies

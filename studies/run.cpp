@@ -49,7 +49,7 @@ int run_study(const StudyRequest& c) {
   // The studies read fills and flows, not FEM decks or their runs' pictures: no hand-off, whose
   // mesh and CalculiX run would add seconds to each of their many runs, and no pictures (python,
   // about 1.5 s a run); the study draws its own charts.
-  scene.fem_elements = "none";
+  scene.fem.elements = scene::FemElements::none;
   scene.pictures = false;
   if (c.threads) scene.threads = *c.threads;
   if (c.seed) scene.seed = *c.seed;

@@ -34,7 +34,7 @@ struct Setting {
 };
 
 std::vector<Setting> settings(const scene::PipelineScene& scene, bool reduced) {
-  const double dt = scene.spec.time_step_fraction, voxel = scene.die_voxel_fraction;
+  const double dt = scene.spec.time_step_fraction, voxel = scene.die.voxel_fraction;
   const double root2 = std::sqrt(2.0);
   std::vector<Setting> runs = {
       {"reference", "the scene's settings", 1, 1, dt, voxel},
@@ -105,13 +105,13 @@ RunResult run_setting(const scene::PipelineScene& scene, const Setting& setting,
   RunResult r;
   r.setting = setting;
   scene::PipelineScene s = scene;
-  s.coarse_graining *= setting.coarser;
+  s.powder.coarse_graining *= setting.coarser;
   s.spec.materials[std::size_t(scene::powder_material(s.spec))].youngs_modulus *= setting.stiffness;
   s.spec.time_step_fraction = setting.time_step_fraction;
-  s.die_voxel_fraction = setting.voxel_fraction;
+  s.die.voxel_fraction = setting.voxel_fraction;
   s.seed += setting.seed_offset;
-  s.out = out.work() / fmt::format("run_{}", index);  // its own cache: every run from nothing
-  r.alpha = s.coarse_graining;
+  s.output.directory = out.work() / fmt::format("run_{}", index);  // its own cache: every run from nothing
+  r.alpha = s.powder.coarse_graining;
   diefill::log::info("speed-accuracy: {} ({})", setting.label, setting.group);
   diefill::Stopwatch clock;
   try {

@@ -195,8 +195,8 @@ std::string wall_speed_run(const Powder& powder, double step_over_half_skin) {
 std::string coarse_cavity_run(const scene::PipelineScene& scene, double diameter_over_width, const std::filesystem::path& work) {
   // The ring's annulus is 5 mm wide.
   scene::PipelineScene s = scene;
-  s.coarse_graining = diameter_over_width * 5e-3 / s.particle_diameter;
-  s.out = work / fmt::format("cavity_{:.3g}", diameter_over_width);
+  s.powder.coarse_graining = diameter_over_width * 5e-3 / s.powder.particle_diameter;
+  s.output.directory = work / fmt::format("cavity_{:.3g}", diameter_over_width);
   const pipeline::DieRun run = pipeline::run_die_fill(s, ring_mesh(work), false);
   const auto& particles = run.report["particles"];
   if (particles.value("in_cavity", 0) == 0) return "no grain entered the cavity";

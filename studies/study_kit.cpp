@@ -17,11 +17,11 @@ using dem::Vec3;
 
 Powder powder_of(const scene::PipelineScene& scene) {
   Powder p;
-  p.spec = scene::coarse_grained_spec(scene.spec, scene.coarse_graining);
+  p.spec = scene::coarse_grained_spec(scene.spec, scene.powder.coarse_graining);
   p.powder = scene::powder_material(scene.spec);
   p.wall = scene::tool_material(scene.spec);
-  p.diameter = scene.grain_diameter();
-  p.spread = scene.diameter_spread;
+  p.diameter = scene.powder.grain_diameter();
+  p.spread = scene.powder.diameter_spread;
   p.density = scene.spec.materials[std::size_t(p.powder)].density;
   p.seed = scene.seed;
   p.source = scene.source;

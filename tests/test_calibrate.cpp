@@ -117,13 +117,13 @@ TEST(Examples, EachLoadsAndEachSceneRunsCoarsely) {
     }
     test::TempDir dir;
     scene::PipelineScene s = scene::load_pipeline_scene(entry.path(), {});
-    s.out = dir / "out";
-    s.cache = dir / "cache";
+    s.output.directory = dir / "out";
+    s.output.cache = dir / "cache";
     s.max_steps = 30;
-    s.max_grains = std::min<std::size_t>(s.max_grains, 3000);
-    s.fem_elements = "none";
+    s.powder.max_grains = std::min<std::size_t>(s.powder.max_grains, 3000);
+    s.fem.elements = scene::FemElements::none;
     s.pictures = false;
-    EXPECT_NO_THROW(EXPECT_FALSE(pipeline::run_die_fill(s, s.die, false).interrupted)) << entry.path();
+    EXPECT_NO_THROW(EXPECT_FALSE(pipeline::run_die_fill(s, s.die.file, false).interrupted)) << entry.path();
     ++scenes;
   }
   EXPECT_GE(scenes, 4);

@@ -80,9 +80,9 @@ TEST(Cli, SdfRejectsBadMeshesClearly) {
   EXPECT_EQ(guessed.status, 0) << guessed.output;
   EXPECT_NE(guessed.output.find("read as m (20 mm across"), std::string::npos) << guessed.output;
   expect_bad_input("sdf --units furlong " + d + "/ring.stl", "--units", "unknown length unit");
-  expect_bad_input("run --units furlong " + d + "/ring.stl", "die.units", "unknown length unit");
+  expect_bad_input("run --units furlong " + d + "/ring.stl", "--units", "unknown length unit");
   expect_bad_input("sdf --up sideways " + d + "/ring.stl", "--up", "not a direction");
-  expect_bad_input("run --up sideways " + d + "/ring.stl", "die.up", "not a direction");
+  expect_bad_input("run --up sideways " + d + "/ring.stl", "--up", "not a direction");
   expect_bad_input("sdf --voxel -1 " + d + "/ring.stl", "voxel", "positive");
 }
 

@@ -405,7 +405,7 @@ TEST(PipelineOwnRuns, SweepRunsEachCaseAsItsSingleRun) {
                                           "motion.die_settle_time=0.01", "fem.elements=none"};
     overrides.insert(overrides.end(), more.begin(), more.end());
     scene::PipelineScene scene = scene::load_pipeline_scene(std::nullopt, overrides);
-    scene.die = bundled_die("disc");
+    scene.die.file = bundled_die("disc");
     scene.pictures = false;  // the sweep's own chart is drawn regardless
     return scene;
   };

@@ -194,15 +194,15 @@ TEST(SceneKeys, MutatedScenesThatLoadRunOrStopClearly) {
     } catch (const diefill::InputError&) {
       continue;
     }
-    s.die = test::source_dir() / "dies" / "disc.stl";
-    s.out = dir / "out";
-    s.cache = dir / "cache";
+    s.die.file = test::source_dir() / "dies" / "disc.stl";
+    s.output.directory = dir / "out";
+    s.output.cache = dir / "cache";
     s.max_steps = 30;
-    s.max_grains = std::min<std::size_t>(s.max_grains, 400);
-    s.fem_compaction = "none";
+    s.powder.max_grains = std::min<std::size_t>(s.powder.max_grains, 400);
+    s.fem.compaction = scene::FemCompaction::none;
     s.pictures = false;
     try {
-      const pipeline::DieRun run = pipeline::run_die_fill(s, s.die, false);
+      const pipeline::DieRun run = pipeline::run_die_fill(s, s.die.file, false);
       EXPECT_FALSE(run.interrupted);
       ++completed;
     } catch (const diefill::InputError&) {
@@ -224,15 +224,15 @@ TEST(SettledShoe, KeyFollowsTheSettlingKeysAndTheDemCode) {
   EXPECT_EQ(pipeline::settled_shoe_key(scene, inputs, "dem-code-a"), key);
   EXPECT_NE(pipeline::settled_shoe_key(scene, inputs, "dem-code-b"), key) << "changed DEM sources";
   scene::PipelineScene other = scene;
-  other.shoe_settle_time *= 1.5;
+  other.motion.shoe_settle_time *= 1.5;
   EXPECT_NE(pipeline::settled_shoe_key(other, inputs, "dem-code-a"), key) << "a settling key";
   other = scene;
   other.spec.materials[0].sliding_friction = 0.45;
   EXPECT_NE(pipeline::settled_shoe_key(other, inputs, "dem-code-a"), key) << "a material";
   other = scene;
-  other.speed = 0.3;
-  other.die_settle_time = 0.2;
-  other.density_voxel = 1e-3;
+  other.motion.speed = 0.3;
+  other.motion.die_settle_time = 0.2;
+  other.density.voxel = 1e-3;
   other.threads = 2;
   EXPECT_EQ(pipeline::settled_shoe_key(other, inputs, "dem-code-a"), key) << "keys that act after the shoe has settled";
 }
@@ -242,8 +242,8 @@ TEST(SettledShoe, KeyFollowsTheSettlingKeysAndTheDemCode) {
 TEST(SceneKeys, ALengthKeyTakesItsUnit) {
   const scene::PipelineScene metres = scene::load_pipeline_scene(std::nullopt, {"shoe.length=0.04"});
   // 40 x 1e-3 is the double nearest 0.04 or its neighbour: the unit's factor is one rounding.
-  EXPECT_DOUBLE_EQ(scene::load_pipeline_scene(std::nullopt, {"shoe.length=40mm"}).shoe_length, metres.shoe_length);
-  EXPECT_DOUBLE_EQ(scene::load_pipeline_scene(std::nullopt, {"shoe.length=\"40 mm\""}).shoe_length, metres.shoe_length);
+  EXPECT_DOUBLE_EQ(scene::load_pipeline_scene(std::nullopt, {"shoe.length=40mm"}).shoe.length, metres.shoe.length);
+  EXPECT_DOUBLE_EQ(scene::load_pipeline_scene(std::nullopt, {"shoe.length=\"40 mm\""}).shoe.length, metres.shoe.length);
   EXPECT_EQ(scene::load_pipeline_scene(std::nullopt, {"simulation.skin=50um"}).spec.skin.value_or(0), 50 * 1e-6);
   try {
     scene::load_pipeline_scene(std::nullopt, {"shoe.length=40furlongs"});

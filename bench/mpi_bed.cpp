@@ -3,7 +3,7 @@
 // what a split run costs per rank: peak memory over the owned grains, global collectives and
 // point-to-point messages per step, and times the set-up, the steps, the checkpoint and the
 // particle output. With --resume it goes on from a checkpoint, on any rank count.
-#include "cli/bench_mpi.hpp"
+#include "bench/mpi_bed.hpp"
 
 #include <fmt/core.h>
 #include <sys/resource.h>
@@ -11,7 +11,6 @@
 #include <cmath>
 #include <cstring>
 
-#include "cli/mpi_session.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/timer.hpp"
@@ -20,14 +19,14 @@
 #include "dem/io.hpp"
 #include "dem/step.hpp"
 
-namespace cli {
+namespace bench {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace {
 
-// The bed: 1 mm grains of the LIGGGHTS reference material (cmd_bench.cpp) on a simple cubic
+// The bed: 1 mm grains of the LIGGGHTS reference material (cases.cpp) on a simple cubic
 // lattice a hair tighter than the grains (every grain touches its six neighbours), 40 layers
 // deep and four times as long as wide, so that cuts across its length give the ranks slabs.
 constexpr double radius = 0.5e-3, pitch = 2 * radius * (1 - 2e-4);
@@ -142,8 +141,7 @@ json census_json(const Census& c) {
 
 }  // namespace
 
-json run_mpi_bed(const BenchCommand& c) {
-  const std::shared_ptr<dem::Exchange> exchange = mpi_exchange();
+json run_mpi_bed(const Request& c, const std::shared_ptr<dem::Exchange>& exchange) {
   if (!exchange)
     throw diefill::InputError("bench mpi-bed", "mpirun", "the case measures a run split over MPI ranks",
                               "Run it under mpirun (bench/mpi_10m.sh)");
@@ -222,4 +220,4 @@ json run_mpi_bed(const BenchCommand& c) {
   return result;
 }
 
-}  // namespace cli
+}  // namespace bench
