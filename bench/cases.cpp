@@ -13,7 +13,6 @@
 #include "bench/mpi_bed.hpp"
 #include "dem/distributed.hpp"
 #include "pipeline/die_fill.hpp"
-#include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/resources.hpp"
 #include "core/log.hpp"
@@ -180,7 +179,7 @@ std::pair<dem::Model, dem::State> ring_pack(std::size_t count, const fs::path& c
   spec.skin = 0.5 * r;
   spec.gravity = dem::Vec3(0, 0, -9.81);
   spec.domain = {dem::Vec3(-14e-3, -14e-3, -11e-3), dem::Vec3(14e-3, 14e-3, 30e-3)};
-  spec.meshes.push_back(dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid)), 0, "ring"));
+  spec.meshes.push_back(dem::fixed_mesh_wall(std::make_shared<const geometry::WallField>(die.sdf.wall_field(die.solid)), 0, "ring"));
   const fs::path packed = cache / fmt::format("ring_pack_{}.csv", count);
   dem::State s;
   if (fs::exists(packed)) {
@@ -277,10 +276,10 @@ json run_cases(const Request& c, const std::shared_ptr<dem::Exchange>& ranks) {
       mesh::DieOptions options = mesh::die_options_for_grains(0.5e-3, 0.25e-3);
       options.role = mesh::WallRole::container;
       const mesh::PreparedDie die = mesh::prepare_die(c.stl, options, c.cache);
-      const mesh::Box box = die.after.bbox;
+      const geometry::Box box = die.after.bbox;
       spec.domain = {dem::Vec3(box.lo.x(), box.lo.y(), box.lo.z()) - dem::Vec3::Constant(1e-3),
                      dem::Vec3(box.hi.x(), box.hi.y(), box.hi.z()) + dem::Vec3::Constant(1e-3)};
-      spec.meshes.push_back(dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid)), 0, "container"));
+      spec.meshes.push_back(dem::fixed_mesh_wall(std::make_shared<const geometry::WallField>(die.sdf.wall_field(die.solid)), 0, "container"));
       const dem::Model model = dem::compile_model(spec, pack, c.pack.string());
       json r = time_case(name, model, pack, c.steps, thread_counts, ranks);
       r["pack"] = c.pack.string();

@@ -30,8 +30,8 @@ double relative_clump_cost(int spheres) {
 }  // namespace
 
 int run_clump(const ClumpCommand& c) {
-  const mesh::ClumpTemplate clump =
-      pipeline::build_clump({c.mesh, mesh::parse_unit(c.units, "--units"), c.tolerance, c.max_spheres, c.seed});
+  const geometry::ClumpTemplate clump =
+      pipeline::build_clump({c.mesh, geometry::parse_unit(c.units, "--units"), c.tolerance, c.max_spheres, c.seed});
 
   // -o names the template file when it ends in .json (docs/INTERFACE.md), else a folder for it.
   const bool file = c.output.extension() == ".json";
@@ -40,7 +40,7 @@ int run_clump(const ClumpCommand& c) {
   if (!json.parent_path().empty()) fs::create_directories(json.parent_path());
   diefill::write_file_atomic(json, mesh::clump_json(clump));
   std::string csv = "spheres,volume_error,hausdorff_error,relative_cost\n";
-  for (const mesh::ClumpStep& step : clump.history)
+  for (const geometry::ClumpStep& step : clump.history)
     csv += fmt::format("{},{:.6g},{:.6g},{:.4g}\n", step.spheres, step.volume_error, step.hausdorff_error,
                        relative_clump_cost(step.spheres));
   diefill::write_file_atomic(errors, csv);

@@ -8,8 +8,8 @@
 namespace cli {
 
 int run_die(const DieCommand& c) {
-  const mesh::TriMesh die = mesh::bundled_die(c.name);
-  mesh::write_stl(die, c.output, mesh::LengthUnit::mm, "diefill " + c.name + " cavity, mm");
+  const geometry::TriMesh die = mesh::bundled_die(c.name);
+  mesh::write_stl(die, c.output, geometry::LengthUnit::mm, "diefill " + c.name + " cavity, mm");
   fmt::print("wrote {} ({} triangles)\n", c.output.string(), die.triangles.size());
   return 0;
 }

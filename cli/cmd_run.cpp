@@ -14,7 +14,6 @@
 #include "pipeline/folder_run.hpp"
 #include "pipeline/ladder.hpp"
 #include "pipeline/run_plan.hpp"
-#include "pipeline/preflight.hpp"
 #include "pipeline/sweep.hpp"
 #include "pipeline/run_loop.hpp"
 #include "studies/measured_powder.hpp"
@@ -39,7 +38,7 @@ void apply_command_line(scene::PipelineScene& scene, const RunCommand& c) {
   if (!c.out.empty()) scene.output.directory = c.out;
   if (c.threads) scene.threads = *c.threads;
   if (c.up) scene.die.up = mesh::parse_up(*c.up, "--up");
-  if (c.units) scene.die.units = mesh::parse_unit_or_auto(*c.units, "--units");
+  if (c.units) scene.die.units = geometry::parse_unit_or_auto(*c.units, "--units");
   scene.force = c.force;
 }
 

@@ -21,11 +21,11 @@ int run_sdf(const SdfCommand& c) {
   options.table_margin_m = c.table_margin_mm * mm;
 
   options.parting = mesh::parse_parting(c.parting, "--parting");
-  const mesh::DieFile file = mesh::read_die_file(c.mesh, mesh::parse_unit_or_auto(c.units, "--units"),
+  const mesh::DieFile file = mesh::read_die_file(c.mesh, geometry::parse_unit_or_auto(c.units, "--units"),
                                                  mesh::up_to_read(options), mesh::parting_to_read(options), c.part);
   options.unit = file.unit;
   const mesh::PreparedDie die = mesh::prepare_die(file, options, std::nullopt);
-  fmt::print("mesh {} ({} units{}: {})\n", die.source, mesh::unit_name(options.unit),
+  fmt::print("mesh {} ({} units{}: {})\n", die.source, geometry::unit_name(options.unit),
              file.unit_guessed ? ", guessed from its size; --units chooses" : "", die.sha256);
   if (file.part > 0)
     fmt::print("part {} of the file's {} bodies (pieces that share no vertex), numbered by enclosed volume, largest first (--part)\n",
@@ -56,7 +56,7 @@ int run_sdf(const SdfCommand& c) {
              double(die.sdf.memory_bytes()) / (1 << 20));
   if (c.verify > 0) {
     const mesh::ExactSurface exact(die.solid);
-    const mesh::WallField field = die.sdf.wall_field(die.solid);
+    const geometry::WallField field = die.sdf.wall_field(die.solid);
     const mesh::SdfVerification v = mesh::verify_sdf(field, die.solid, exact, c.verify, c.seed);
     fmt::print("verify: {} points in the band (seed {}), {} farther than a voxel from a sharp "
                "edge, {} with |exact| > 0.5 voxel, {} outside or within a voxel inside (where grain centres go)\n",

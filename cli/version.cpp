@@ -2,6 +2,7 @@
 
 #include "cli/commands.hpp"
 #include "core/resources.hpp"
+#include "geometry/versions.hpp"
 #include "mesh/versions.hpp"
 
 namespace cli {
@@ -10,7 +11,7 @@ std::string version_text() {
   return fmt::format(
       "diefill {}\n  CGAL {}\n  OpenVDB {}\n  assimp {}\n  Embree {}\n  Eigen {}\n  data: {}", DIEFILL_VERSION,
       mesh::cgal_version(), mesh::openvdb_version(), mesh::assimp_version(), mesh::embree_version(),
-      mesh::eigen_version(), diefill::resource_path("").string());
+      geometry::eigen_version(), diefill::resource_path("").string());
 }
 
 }  // namespace cli

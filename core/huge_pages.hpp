@@ -13,7 +13,7 @@ namespace diefill {
 // 4 KiB pages a 50k pack spans thousands of pages, and in a virtual machine each TLB miss walks the
 // guest's and the host's page tables; runs whose memory the host had backed poorly ran all
 // stages 1.5 times slower, in half the processes (docs/PERFORMANCE.md, "How the kernel is built, and why"). A wall's
-// triangles are read at random, a page or more per grain near the wall (mesh/wall_field.hpp).
+// triangles are read at random, a page or more per grain near the wall (geometry/wall_field.hpp).
 template <class T>
 struct HugePageAllocator {
   using value_type = T;

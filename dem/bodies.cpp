@@ -41,13 +41,13 @@ void rotate_about_axis(int k, double t, const Vec3& inertia, Vec3& pi, Quat& q) 
 
 }  // namespace
 
-double bounding_radius(const mesh::ClumpTemplate& clump) {
+double bounding_radius(const geometry::ClumpTemplate& clump) {
   double r = 0;
-  for (const mesh::ClumpSphere& sphere : clump.spheres) r = std::max(r, sphere.centre.norm() + sphere.radius);
+  for (const geometry::ClumpSphere& sphere : clump.spheres) r = std::max(r, sphere.centre.norm() + sphere.radius);
   return r;
 }
 
-std::size_t add_clump(State& s, const mesh::ClumpTemplate& clump, double scale, std::int64_t first_id,
+std::size_t add_clump(State& s, const geometry::ClumpTemplate& clump, double scale, std::int64_t first_id,
                       const Vec3& position, const Quat& q, double density, int material, const Vec3& velocity,
                       const Vec3& angular_velocity) {
   if (!(clump.mesh_volume_m3 > 0) || !(clump.inertia_principal_per_density.minCoeff() > 0) || clump.spheres.empty())

@@ -10,7 +10,7 @@
 
 #include "dem/model.hpp"
 #include "dem/state.hpp"
-#include "mesh/clump_template.hpp"
+#include "geometry/clump_template.hpp"
 
 namespace dem {
 
@@ -18,12 +18,12 @@ namespace dem {
 // (principal frame to world), members with ids first_id, first_id + 1, ...; mass and inertia
 // from the grain (density × mesh volume, density × principal moments). Returns the body index.
 // Throws InputError for a template without spheres, volume or moments.
-std::size_t add_clump(State& state, const mesh::ClumpTemplate& clump, double scale, std::int64_t first_id,
+std::size_t add_clump(State& state, const geometry::ClumpTemplate& clump, double scale, std::int64_t first_id,
                       const Vec3& position, const Quat& q, double density, int material,
                       const Vec3& velocity = Vec3::Zero(), const Vec3& angular_velocity = Vec3::Zero());
 
 // Radius of the sphere about the centre that holds every member [m], before scaling.
-double bounding_radius(const mesh::ClumpTemplate& clump);
+double bounding_radius(const geometry::ClumpTemplate& clump);
 
 // Members' positions and velocities from their bodies' poses and velocities: after setting a
 // body's state by hand.

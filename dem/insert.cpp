@@ -83,7 +83,7 @@ std::size_t insert_spheres(State& s, const InsertRegion& region, const InsertReq
   return added;
 }
 
-std::size_t insert_clumps(State& s, const InsertRegion& region, const mesh::ClumpTemplate& clump, double scale,
+std::size_t insert_clumps(State& s, const InsertRegion& region, const geometry::ClumpTemplate& clump, double scale,
                           std::size_t count, int material, double density, std::uint64_t seed, std::int64_t first_id) {
   Random random(seed);
   // Random sequential addition of the clumps' bounding spheres: a candidate whose bounding

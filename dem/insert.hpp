@@ -9,7 +9,7 @@
 
 #include "dem/model.hpp"
 #include "dem/state.hpp"
-#include "mesh/clump_template.hpp"
+#include "geometry/clump_template.hpp"
 
 namespace dem {
 
@@ -17,7 +17,7 @@ struct InsertRegion {
   Box3 box;  // candidate centres are drawn here
   // When set, a centre is kept only if the sphere lies inside this solid (distance <= -r; the
   // field's solid-side band must reach the largest radius, or no grain deeper than it fits).
-  std::shared_ptr<const mesh::WallField> inside;
+  std::shared_ptr<const geometry::WallField> inside;
   // ... and outside every wall of the model (distance >= r) when this is given.
   const Model* clear_of_walls = nullptr;
   // ... and where this accepts the centre and radius, when given.
@@ -43,7 +43,7 @@ std::size_t insert_spheres(State& state, const InsertRegion& region, const Inser
 // orientations, no overlap with each other or the grains present (their bounding spheres are
 // tested, against the region too); members get ids from first_id on. Returns how many were
 // added: fewer than `count` when the region is full.
-std::size_t insert_clumps(State& state, const InsertRegion& region, const mesh::ClumpTemplate& clump, double scale,
+std::size_t insert_clumps(State& state, const InsertRegion& region, const geometry::ClumpTemplate& clump, double scale,
                           std::size_t count, int material, double density, std::uint64_t seed,
                           std::int64_t first_id = 0);
 

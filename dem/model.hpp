@@ -12,7 +12,7 @@
 #include "dem/contact_laws.hpp"
 #include "dem/motion.hpp"
 #include "dem/types.hpp"
-#include "mesh/wall_field.hpp"
+#include "geometry/wall_field.hpp"
 
 namespace dem {
 
@@ -42,7 +42,7 @@ struct PlaneWall {
 
 // A rigid wall given by a distance field in its own frame, placed by its motion.
 struct MeshWall {
-  std::shared_ptr<const mesh::WallField> field;
+  std::shared_ptr<const geometry::WallField> field;
   int material = 0;
   Motion motion;
   std::string name = "mesh";
@@ -64,7 +64,7 @@ struct MeshWall {
 };
 
 // A wall at rest in the world frame.
-inline MeshWall fixed_mesh_wall(std::shared_ptr<const mesh::WallField> field, int material, std::string name) {
+inline MeshWall fixed_mesh_wall(std::shared_ptr<const geometry::WallField> field, int material, std::string name) {
   MeshWall wall;
   wall.field = std::move(field);
   wall.material = material;

@@ -26,7 +26,7 @@ struct WallSlot {
 
 // Where a grain's wall queries start, per mesh wall: the closest triangles of the voxel cell it
 // was in, each moved on to where its walk to a local minimum ended, with watches where a walk
-// left a surface over a sharp edge (mesh::WallField::local_minima_tracked), so that a query walks
+// left a surface over a sharp edge (geometry::WallField::local_minima_tracked), so that a query walks
 // over a triangle or none instead of a voxel's worth of them: the wall cost does not grow with
 // the tessellation. Read afresh from the voxels when the grain is a quarter voxel beyond the cell
 // (dem/walls.cpp) and at every neighbour build, when grains migrate between ranks. Part of the

@@ -15,7 +15,7 @@ namespace {
 // ../shared/bench/liggghts, a hundred triangles and more per query instead of one or two).
 constexpr double cell_margin = 0.25;  // [voxels]
 
-bool left_cell(const mesh::WallField& field, const WallCandidates& c, const Vec3& p) {
+bool left_cell(const geometry::WallField& field, const WallCandidates& c, const Vec3& p) {
   for (int k = 0; k < 3; ++k) {
     const double into = p[k] / field.voxel - c.cell[std::size_t(k)];
     if (into < -cell_margin || into > 1 + cell_margin) return true;
@@ -40,7 +40,7 @@ int wall_hits(const Model& model, double time, const Vec3& x, double r, WallHit*
     if (height_above_cut <= 0) continue;
     const bool moving = model.mesh_moves[m];
     const Vec3 local = moving ? wall.motion.to_local(time, x) : x;
-    mesh::SurfacePoint minima[wall_slots_per_particle];
+    geometry::SurfacePoint minima[wall_slots_per_particle];
     WallCandidates fresh;
     WallCandidates& c = cache ? cache[m] : fresh;
     if (c.count < 0 || left_cell(*wall.field, c, local)) {

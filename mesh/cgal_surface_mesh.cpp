@@ -4,8 +4,8 @@
 
 namespace mesh::detail {
 
-TriMesh to_trimesh(const SurfaceMesh& sm) {
-  TriMesh out;
+geometry::TriMesh to_trimesh(const SurfaceMesh& sm) {
+  geometry::TriMesh out;
   std::vector<int> index(sm.number_of_vertices() + sm.number_of_removed_vertices(), -1);
   for (auto v : sm.vertices()) {
     index[v.idx()] = int(out.vertices.size());
@@ -13,7 +13,7 @@ TriMesh to_trimesh(const SurfaceMesh& sm) {
     out.vertices.emplace_back(p.x(), p.y(), p.z());
   }
   for (auto f : sm.faces()) {
-    Triangle t{};
+    geometry::Triangle t{};
     int k = 0;
     for (auto v : CGAL::vertices_around_face(sm.halfedge(f), sm)) {
       if (k < 3) t[std::size_t(k)] = index[v.idx()];
@@ -24,14 +24,14 @@ TriMesh to_trimesh(const SurfaceMesh& sm) {
   return out;
 }
 
-bool to_surface_mesh(const TriMesh& mesh, SurfaceMesh& out) {
+bool to_surface_mesh(const geometry::TriMesh& mesh, SurfaceMesh& out) {
   namespace PMP = CGAL::Polygon_mesh_processing;
   std::vector<CgalPoint> points;
   points.reserve(mesh.vertices.size());
-  for (const Vec3& v : mesh.vertices) points.emplace_back(v.x(), v.y(), v.z());
+  for (const geometry::Vec3& v : mesh.vertices) points.emplace_back(v.x(), v.y(), v.z());
   std::vector<std::array<std::size_t, 3>> faces;
   faces.reserve(mesh.triangles.size());
-  for (const Triangle& t : mesh.triangles) faces.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
+  for (const geometry::Triangle& t : mesh.triangles) faces.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
   if (!PMP::is_polygon_soup_a_polygon_mesh(faces)) return false;
   PMP::polygon_soup_to_polygon_mesh(points, faces, out);
   return true;

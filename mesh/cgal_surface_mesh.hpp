@@ -5,7 +5,7 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>
 
-#include "mesh/trimesh.hpp"
+#include "geometry/trimesh.hpp"
 
 namespace mesh::detail {
 
@@ -15,10 +15,10 @@ using SurfaceMesh = CGAL::Surface_mesh<CgalPoint>;
 
 // Its triangles (faces of other sizes are left out), vertices numbered afresh: removed vertices
 // and faces are skipped, so no garbage collection is needed before.
-TriMesh to_trimesh(const SurfaceMesh& sm);
+geometry::TriMesh to_trimesh(const SurfaceMesh& sm);
 
 // The triangles as a Surface_mesh; false (and `out` untouched) when they do not form a polygon
 // mesh: an edge shared the wrong way, or by more than two triangles.
-bool to_surface_mesh(const TriMesh& mesh, SurfaceMesh& out);
+bool to_surface_mesh(const geometry::TriMesh& mesh, SurfaceMesh& out);
 
 }  // namespace mesh::detail

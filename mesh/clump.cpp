@@ -54,10 +54,10 @@ using Primitive = CGAL::AABB_triangle_primitive<K, TriangleIt>;
 using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
 using diefill::InputError;
 
-Point to_point(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
-Vec3 to_vec(const Point& p) { return {p.x(), p.y(), p.z()}; }
+Point to_point(const geometry::Vec3& v) { return {v.x(), v.y(), v.z()}; }
+geometry::Vec3 to_vec(const Point& p) { return {p.x(), p.y(), p.z()}; }
 
-bool index_degenerate(const Triangle& t) { return t[0] == t[1] || t[1] == t[2] || t[0] == t[2]; }
+bool index_degenerate(const geometry::Triangle& t) { return t[0] == t[1] || t[1] == t[2] || t[0] == t[2]; }
 
 // Steele, Lea & Flood's SplitMix64: a fixed, portable sequence for a given seed.
 struct SplitMix64 {
@@ -73,9 +73,9 @@ struct SplitMix64 {
 
 // Why the mesh does not bound a solid, or empty. Triangles with a repeated vertex index (the
 // poles of a welded UV sphere) bound nothing and are skipped.
-std::string closure_defect(const TriMesh& m) {
+std::string closure_defect(const geometry::TriMesh& m) {
   std::unordered_map<std::uint64_t, int> directed;
-  for (const Triangle& t : m.triangles) {
+  for (const geometry::Triangle& t : m.triangles) {
     if (index_degenerate(t)) continue;
     for (int k = 0; k < 3; ++k)
       ++directed[(std::uint64_t(std::uint32_t(t[k])) << 32) | std::uint32_t(t[(k + 1) % 3])];
@@ -117,7 +117,7 @@ int edge_side(const Point2& a, const Point2& b, const Point2& p) {
 
 // Where the line {(x, y, z)} along x crosses triangle abc: returns the sign of the triangle's
 // normal's x component (+1: the line leaves the solid there) and sets x, or returns 0.
-int line_crossing(const Vec3& a, const Vec3& b, const Vec3& c, double y, double z, double& x) {
+int line_crossing(const geometry::Vec3& a, const geometry::Vec3& b, const geometry::Vec3& c, double y, double z, double& x) {
   const Point2 pa(a.y(), a.z()), pb(b.y(), b.z()), pc(c.y(), c.z()), p(y, z);
   if (CGAL::orientation(pa, pb, pc) == CGAL::COLLINEAR) return 0;
   const int s = edge_side(pa, pb, p);
@@ -134,8 +134,8 @@ int line_crossing(const Vec3& a, const Vec3& b, const Vec3& c, double y, double 
 // are left out: CGAL's filtered predicates fall back to exact arithmetic on them.
 class Solid {
  public:
-  explicit Solid(const TriMesh& m) {
-    for (const Triangle& t : m.triangles) {
+  explicit Solid(const geometry::TriMesh& m) {
+    for (const geometry::Triangle& t : m.triangles) {
       const Point a = to_point(m.vertices[t[0]]), b = to_point(m.vertices[t[1]]),
                   c = to_point(m.vertices[t[2]]);
       if (!CGAL::collinear(a, b, c)) triangles_.emplace_back(a, b, c);
@@ -147,13 +147,13 @@ class Solid {
   Solid(const Solid&) = delete;
   Solid& operator=(const Solid&) = delete;
 
-  double distance(const Vec3& p) const { return std::sqrt(tree_.squared_distance(to_point(p))); }
+  double distance(const geometry::Vec3& p) const { return std::sqrt(tree_.squared_distance(to_point(p))); }
   // With a surface point at most as far as the answer, which saves the nearest-vertex search.
-  Vec3 closest(const Vec3& p, const Vec3& hint) const {
+  geometry::Vec3 closest(const geometry::Vec3& p, const geometry::Vec3& hint) const {
     return to_vec(tree_.closest_point(to_point(p), to_point(hint)));
   }
   // Distance from p along the unit direction u to the surface, or `otherwise` if none is hit.
-  double ray_distance(const Vec3& p, const Vec3& u, double otherwise) const {
+  double ray_distance(const geometry::Vec3& p, const geometry::Vec3& u, double otherwise) const {
     const auto hit = tree_.first_intersection(K::Ray_3(to_point(p), to_point(p + u)));
     if (!hit) return otherwise;
     if (const Point* q = boost::get<Point>(&hit->first)) return (to_vec(*q) - p).norm();
@@ -161,7 +161,7 @@ class Solid {
   }
 
   // Winding number along the ray from p towards +x.
-  bool contains(const Vec3& p) const {
+  bool contains(const geometry::Vec3& p) const {
     std::vector<TriangleIt> hit;
     tree_.all_intersected_primitives(K::Ray_3(to_point(p), Point(p.x() + 1, p.y(), p.z())),
                                      std::back_inserter(hit));
@@ -186,7 +186,7 @@ constexpr std::uint8_t shell_bit = 2;    // outside, within δmax of the surface
 constexpr std::uint8_t covered_bit = 4;  // inside some chosen sphere
 
 struct Grid {
-  Vec3 origin;
+  geometry::Vec3 origin;
   double h = 0;  // spacing [m]
   std::array<int, 3> n{};
   std::vector<std::uint8_t> state;  // per node, x fastest
@@ -196,7 +196,7 @@ struct Grid {
     return (std::size_t(k) * std::size_t(n[1]) + std::size_t(j)) * std::size_t(n[0]) +
            std::size_t(i);
   }
-  Vec3 node(int i, int j, int k) const { return origin + h * Vec3(i, j, k); }
+  geometry::Vec3 node(int i, int j, int k) const { return origin + h * geometry::Vec3(i, j, k); }
   // Node index range [first, last] whose coordinate along `axis` lies in [lo, hi].
   std::pair<int, int> range(int axis, double lo, double hi) const {
     const int first = std::max(0, int(std::ceil((lo - origin[axis]) / h)));
@@ -205,7 +205,7 @@ struct Grid {
   }
   // Calls f(state&) for every node inside the ball (c, r).
   template <class F>
-  void for_ball(const Vec3& c, double r, F&& f) {
+  void for_ball(const geometry::Vec3& c, double r, F&& f) {
     const auto [k0, k1] = range(2, c.z() - r, c.z() + r);
     for (int k = k0; k <= k1; ++k) {
       const double dz = origin.z() + h * k - c.z(), rz = r * r - dz * dz;
@@ -228,29 +228,29 @@ struct Grid {
 // Nodes classified by scan conversion: each triangle is crossed with the grid lines along x
 // that pass through its (y, z) shadow, and the winding number is swept along each line. One
 // pass over the triangles, exact at edges and vertices (see edge_side).
-Grid make_grid(const TriMesh& m, const Solid& solid, double shell, int samples) {
+Grid make_grid(const geometry::TriMesh& m, const Solid& solid, double shell, int samples) {
   Grid g;
-  const Box box = bounding_box(m);
-  const Vec3 size = box.size() + Vec3::Constant(2 * shell);
+  const geometry::Box box = geometry::bounding_box(m);
+  const geometry::Vec3 size = box.size() + geometry::Vec3::Constant(2 * shell);
   g.h = std::cbrt(size.prod() / std::max(samples, 1000));
   const double margin = shell + g.h;
   // Offsets by fractions of the golden ratio keep grid lines off the faces of axis-aligned,
   // round-numbered meshes.
-  g.origin = box.lo - Vec3::Constant(margin) + g.h * Vec3(0.618034, 0.236068, 0.854102);
+  g.origin = box.lo - geometry::Vec3::Constant(margin) + g.h * geometry::Vec3(0.618034, 0.236068, 0.854102);
   for (int a = 0; a < 3; ++a) g.n[a] = int(std::ceil((box.hi[a] + margin - g.origin[a]) / g.h)) + 1;
   g.state.assign(std::size_t(g.n[0]) * std::size_t(g.n[1]) * std::size_t(g.n[2]), 0);
 
   std::vector<std::vector<std::pair<double, int>>> lines(std::size_t(g.n[1]) * std::size_t(g.n[2]));
   std::vector<std::uint8_t> near(g.state.size(), 0);
-  for (const Triangle& t : m.triangles) {
-    const Vec3 &a = m.vertices[t[0]], &b = m.vertices[t[1]], &c = m.vertices[t[2]];
-    const Vec3 lo = a.cwiseMin(b).cwiseMin(c), hi = a.cwiseMax(b).cwiseMax(c);
+  for (const geometry::Triangle& t : m.triangles) {
+    const geometry::Vec3 &a = m.vertices[t[0]], &b = m.vertices[t[1]], &c = m.vertices[t[2]];
+    const geometry::Vec3 lo = a.cwiseMin(b).cwiseMin(c), hi = a.cwiseMax(b).cwiseMax(c);
     const auto [j0, j1] = g.range(1, lo.y(), hi.y());
     const auto [k0, k1] = g.range(2, lo.z(), hi.z());
     for (int k = k0; k <= k1; ++k)
       for (int j = j0; j <= j1; ++j) {
         double x = 0;
-        const Vec3 p = g.node(0, j, k);
+        const geometry::Vec3 p = g.node(0, j, k);
         if (const int s = line_crossing(a, b, c, p.y(), p.z(), x))
           lines[std::size_t(k) * std::size_t(g.n[1]) + std::size_t(j)].emplace_back(x, s);
       }
@@ -284,7 +284,7 @@ Grid make_grid(const TriMesh& m, const Solid& solid, double shell, int samples) 
 }
 
 struct Ball {
-  Vec3 c;
+  geometry::Vec3 c;
   double r;
 };
 
@@ -293,13 +293,13 @@ struct Ball {
 // until its nearest surface point is p itself. Its centre approximates a medial-axis point.
 // The ball cannot be wider than the chord along n, which gives the first radius: deep closest-
 // point queries are the cost here, and on a convex grain the first one is the last.
-std::optional<Ball> medial_ball(const Solid& solid, const Vec3& p, const Vec3& n, double r_max) {
+std::optional<Ball> medial_ball(const Solid& solid, const geometry::Vec3& p, const geometry::Vec3& n, double r_max) {
   const double lift = 1e-9 * r_max;  // off p's own triangle
   double r = 0.5 * (lift + solid.ray_distance(p + lift * n, n, 2 * r_max));
   const double r0 = r;
   for (int iteration = 0; iteration < 50; ++iteration) {
-    const Vec3 c = p + r * n;
-    const Vec3 q = solid.closest(c, p);
+    const geometry::Vec3 c = p + r * n;
+    const geometry::Vec3 q = solid.closest(c, p);
     const double d = (c - q).norm();
     if (d >= r * (1 - 1e-6)) return Ball{c, d};
     const double denominator = 2 * n.dot(q - p);
@@ -312,20 +312,20 @@ std::optional<Ball> medial_ball(const Solid& solid, const Vec3& p, const Vec3& n
 
 // A surface point where the Hausdorff distance is measured, with its inward direction.
 struct Probe {
-  Vec3 p, inward;
+  geometry::Vec3 p, inward;
   double gap = std::numeric_limits<double>::infinity();  // min_i |p − c_i| − r_i
 };
 
 // A point on a chosen sphere; it is on the union's boundary while no other sphere holds it.
 struct BoundaryPoint {
-  Vec3 p;
+  geometry::Vec3 p;
   double distance;  // to the grain's surface
   bool exposed;
 };
 
 // Fixed directions on the unit sphere (a Fibonacci lattice), for the union's boundary.
-std::vector<Vec3> fibonacci_directions(int count) {
-  std::vector<Vec3> out;
+std::vector<geometry::Vec3> fibonacci_directions(int count) {
+  std::vector<geometry::Vec3> out;
   const double golden = std::numbers::pi * (3 - std::sqrt(5.0));
   for (int i = 0; i < count; ++i) {
     const double z = 1 - (2 * i + 1.0) / count, rho = std::sqrt(1 - z * z);
@@ -337,7 +337,7 @@ std::vector<Vec3> fibonacci_directions(int count) {
 // The greedy selection and its running error state.
 class Builder {
  public:
-  Builder(const TriMesh& m, const ClumpOptions& o, double d_eq)
+  Builder(const geometry::TriMesh& m, const ClumpOptions& o, double d_eq)
       : mesh_(m),
         solid_(m),
         options_(o),
@@ -356,7 +356,7 @@ class Builder {
   }
 
   // Adds spheres until both errors meet the tolerance; the history records every step.
-  void run(ClumpTemplate& out) {
+  void run(geometry::ClumpTemplate& out) {
     const double tol = options_.tolerance;
     while (int(spheres_.size()) < options_.max_spheres) {
       if (!spheres_.empty() && volume_error() <= tol && hausdorff_error() <= tol) break;
@@ -397,14 +397,14 @@ class Builder {
 
   // Candidates about centre c at distance d from the surface: inscribed, and poking out by up
   // to δmax.
-  void push_candidates(const Vec3& c, double d, std::vector<Ball>& to) const {
+  void push_candidates(const geometry::Vec3& c, double d, std::vector<Ball>& to) const {
     for (const double f : {0.0, 0.5, 1.0})
       if (d + f * delta_ > 0) to.push_back({c, d + f * delta_});
   }
 
   // Pool candidates, one per grid cell of centre and radius: on a round grain thousands of
   // medial balls coincide, and polishing recovers what the rounding loses.
-  void pool_candidates(const Vec3& c, double d) {
+  void pool_candidates(const geometry::Vec3& c, double d) {
     std::uint64_t key = 0;
     for (const double v :
          {c.x() - grid_.origin.x(), c.y() - grid_.origin.y(), c.z() - grid_.origin.z(), d})
@@ -414,19 +414,19 @@ class Builder {
 
   void make_probes_and_medial_candidates() {
     // Vertices, with angle-weighted normals: sharp corners are where the error peaks.
-    std::vector<Vec3> normals(mesh_.vertices.size(), Vec3::Zero());
+    std::vector<geometry::Vec3> normals(mesh_.vertices.size(), geometry::Vec3::Zero());
     std::vector<double> cumulative_area;
     double area = 0;
-    for (const Triangle& t : mesh_.triangles) {
-      const Vec3 &a = mesh_.vertices[t[0]], &b = mesh_.vertices[t[1]], &c = mesh_.vertices[t[2]];
-      const Vec3 cross = (b - a).cross(c - a);
+    for (const geometry::Triangle& t : mesh_.triangles) {
+      const geometry::Vec3 &a = mesh_.vertices[t[0]], &b = mesh_.vertices[t[1]], &c = mesh_.vertices[t[2]];
+      const geometry::Vec3 cross = (b - a).cross(c - a);
       area += 0.5 * cross.norm();
       cumulative_area.push_back(area);
       if (cross.norm() == 0) continue;
-      const Vec3 n = cross.normalized();
+      const geometry::Vec3 n = cross.normalized();
       for (int k = 0; k < 3; ++k) {
-        const Vec3 u = mesh_.vertices[t[(k + 1) % 3]] - mesh_.vertices[t[k]];
-        const Vec3 v = mesh_.vertices[t[(k + 2) % 3]] - mesh_.vertices[t[k]];
+        const geometry::Vec3 u = mesh_.vertices[t[(k + 1) % 3]] - mesh_.vertices[t[k]];
+        const geometry::Vec3 v = mesh_.vertices[t[(k + 2) % 3]] - mesh_.vertices[t[k]];
         const double angle = std::atan2(u.cross(v).norm(), u.dot(v));
         normals[std::size_t(t[k])] += angle * n;
       }
@@ -436,20 +436,20 @@ class Builder {
 
     // Area-weighted random surface points: probes, and seeds of medial balls.
     SplitMix64 rng{options_.seed};
-    const double r_max = bounding_box(mesh_).size().norm();
+    const double r_max = geometry::bounding_box(mesh_).size().norm();
     constexpr int surface_samples = 3000, medial_seeds = 1500;
     for (int s = 0; s < surface_samples; ++s) {
       const double pick = rng.uniform() * area;
       const auto f =
           std::size_t(std::upper_bound(cumulative_area.begin(), cumulative_area.end(), pick) -
                       cumulative_area.begin());
-      const Triangle& t = mesh_.triangles[std::min(f, mesh_.triangles.size() - 1)];
-      const Vec3 &a = mesh_.vertices[t[0]], &b = mesh_.vertices[t[1]], &c = mesh_.vertices[t[2]];
-      const Vec3 cross = (b - a).cross(c - a);
+      const geometry::Triangle& t = mesh_.triangles[std::min(f, mesh_.triangles.size() - 1)];
+      const geometry::Vec3 &a = mesh_.vertices[t[0]], &b = mesh_.vertices[t[1]], &c = mesh_.vertices[t[2]];
+      const geometry::Vec3 cross = (b - a).cross(c - a);
       const double u = std::sqrt(rng.uniform()), v = rng.uniform();
       if (cross.norm() == 0) continue;
-      const Vec3 p = a * (1 - u) + b * (u * (1 - v)) + c * (u * v);
-      const Vec3 inward = -cross.normalized();
+      const geometry::Vec3 p = a * (1 - u) + b * (u * (1 - v)) + c * (u * v);
+      const geometry::Vec3 inward = -cross.normalized();
       probes_.push_back({p, inward});
       if (s < medial_seeds)
         if (const auto ball = medial_ball(solid_, p, inward, r_max))
@@ -464,7 +464,7 @@ class Builder {
       for (int j = 0; j < grid_.n[1]; j += stride)
         for (int i = 0; i < grid_.n[0]; i += stride)
           if (grid_.state[grid_.index(i, j, k)] & inside_bit) {
-            const Vec3 c = grid_.node(i, j, k);
+            const geometry::Vec3 c = grid_.node(i, j, k);
             pool_candidates(c, solid_.distance(c));
           }
   }
@@ -509,11 +509,11 @@ class Builder {
       reaches = [target, reach](const Ball& b) { return (target.p - b.c).norm() - b.r <= reach; };
       // Centres stepped inward from the point along its normal, from half the grain down.
       for (double t = 0.5 * d_eq_; t > 1e-3 * reach; t *= 0.7) {
-        const Vec3 c = target.p + t * target.inward;
+        const geometry::Vec3 c = target.p + t * target.inward;
         if (solid_.contains(c)) push_candidates(c, solid_.distance(c), local);
       }
     } else {
-      const Vec3 q = boundary_[*worst_boundary].p;
+      const geometry::Vec3 q = boundary_[*worst_boundary].p;
       reaches = [q](const Ball& b) { return (q - b.c).norm() < b.r; };
       if (solid_.contains(q)) push_candidates(q, solid_.distance(q), local);
     }
@@ -544,7 +544,7 @@ class Builder {
         long best_gain = g;
         double best_d = d;
         for (int move = 0; move < 7; ++move) {
-          Vec3 c = b.c;
+          geometry::Vec3 c = b.c;
           if (move > 0) c[(move - 1) / 2] += (move % 2 ? step : -step);
           const double dc = move > 0 ? solid_.distance(c) : d;
           for (const double f : {0.0, 0.25, 0.5, 0.75, 1.0}) {
@@ -578,8 +578,8 @@ class Builder {
     for (Probe& p : probes_) p.gap = std::min(p.gap, (p.p - b.c).norm() - b.r);
     for (BoundaryPoint& q : boundary_)
       if (q.exposed && (q.p - b.c).norm() < b.r) q.exposed = false;
-    for (const Vec3& u : directions_) {
-      const Vec3 p = b.c + b.r * u;
+    for (const geometry::Vec3& u : directions_) {
+      const geometry::Vec3 p = b.c + b.r * u;
       const bool hidden = std::any_of(spheres_.begin(), spheres_.end(),
                                       [&](const Ball& s) { return (p - s.c).norm() < s.r; });
       if (!hidden) boundary_.push_back({p, solid_.distance(p), true});
@@ -587,12 +587,12 @@ class Builder {
     spheres_.push_back(b);
   }
 
-  const TriMesh& mesh_;
+  const geometry::TriMesh& mesh_;
   Solid solid_;
   const ClumpOptions& options_;
   double d_eq_, delta_;
   Grid grid_;
-  std::vector<Vec3> directions_;
+  std::vector<geometry::Vec3> directions_;
   std::vector<Probe> probes_;
   std::vector<Ball> pool_;
   std::unordered_set<std::uint64_t> pooled_;         // cells of pool_, see pool_candidates
@@ -618,17 +618,17 @@ struct Sub {
 
 }  // namespace
 
-MassProperties mass_properties(const TriMesh& m) {
+MassProperties mass_properties(const geometry::TriMesh& m) {
   // Integrals about the bounding-box centre, so that a grain far from the origin loses no digits
   // to cancellation.
-  const Box box = bounding_box(m);
-  const Vec3 ref = box.empty() ? Vec3::Zero() : Vec3(0.5 * (box.lo + box.hi));
+  const geometry::Box box = geometry::bounding_box(m);
+  const geometry::Vec3 ref = box.empty() ? geometry::Vec3::Zero() : geometry::Vec3(0.5 * (box.lo + box.hi));
   // 1, x, y, z, x², y², z², xy, yz, zx
   std::array<double, 10> in{};
-  for (const Triangle& t : m.triangles) {
-    const Vec3 p0 = m.vertices[t[0]] - ref, p1 = m.vertices[t[1]] - ref,
-               p2 = m.vertices[t[2]] - ref;
-    const Vec3 d = (p1 - p0).cross(p2 - p0);
+  for (const geometry::Triangle& t : m.triangles) {
+    const geometry::Vec3 p0 = m.vertices[t[0]] - ref, p1 = m.vertices[t[1]] - ref,
+                         p2 = m.vertices[t[2]] - ref;
+    const geometry::Vec3 d = (p1 - p0).cross(p2 - p0);
     const Sub x(p0.x(), p1.x(), p2.x()), y(p0.y(), p1.y(), p2.y()), z(p0.z(), p1.z(), p2.z());
     in[0] += d.x() * x.f1;
     in[1] += d.x() * x.f2;
@@ -648,7 +648,7 @@ MassProperties mass_properties(const TriMesh& m) {
   MassProperties mp;
   mp.volume = in[0];
   if (mp.volume == 0) return mp;
-  const Vec3 c(in[1] / in[0], in[2] / in[0], in[3] / in[0]);
+  const geometry::Vec3 c(in[1] / in[0], in[2] / in[0], in[3] / in[0]);
   const double v = in[0];
   Eigen::Matrix3d& I = mp.inertia_per_density;
   I(0, 0) = in[5] + in[6] - v * (c.y() * c.y() + c.z() * c.z());
@@ -661,7 +661,7 @@ MassProperties mass_properties(const TriMesh& m) {
   return mp;
 }
 
-ClumpTemplate make_clump(const TriMesh& grain, const ClumpOptions& options) {
+geometry::ClumpTemplate make_clump(const geometry::TriMesh& grain, const ClumpOptions& options) {
   if (!(options.tolerance > 0 && options.tolerance < 1))
     throw InputError("", "tolerance", fmt::format("{} is not between 0 and 1", options.tolerance),
                      "Give a relative tolerance such as 0.05");
@@ -676,7 +676,7 @@ ClumpTemplate make_clump(const TriMesh& grain, const ClumpOptions& options) {
     throw InputError("", "mesh", "the mesh is oriented inward (its volume is negative)",
                      "Repair the grain mesh first, which orients it outward");
 
-  ClumpTemplate out;
+  geometry::ClumpTemplate out;
   out.tolerance = options.tolerance;
   out.mesh_volume_m3 = mp.volume;
   out.mesh_centroid = mp.centroid;
@@ -687,7 +687,7 @@ ClumpTemplate make_clump(const TriMesh& grain, const ClumpOptions& options) {
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(mp.inertia_per_density);
   out.inertia_principal_per_density = eigen.eigenvalues();
   Eigen::Matrix3d axes = eigen.eigenvectors();
-  const Vec3& moments = out.inertia_principal_per_density;
+  const geometry::Vec3& moments = out.inertia_principal_per_density;
   if (moments.maxCoeff() - moments.minCoeff() <= 1e-9 * moments.maxCoeff()) axes.setIdentity();
   for (int a = 0; a < 3; ++a) {
     Eigen::Index largest = 0;
@@ -697,19 +697,19 @@ ClumpTemplate make_clump(const TriMesh& grain, const ClumpOptions& options) {
   if (axes.determinant() < 0) axes.col(2) *= -1;
   out.rotation_mesh_to_principal = axes.transpose();
 
-  TriMesh principal = grain;
-  for (Vec3& v : principal.vertices) v = out.rotation_mesh_to_principal * (v - mp.centroid);
+  geometry::TriMesh principal = grain;
+  for (geometry::Vec3& v : principal.vertices) v = out.rotation_mesh_to_principal * (v - mp.centroid);
 
   Builder builder(principal, options, out.equivalent_diameter_m);
   builder.run(out);
   if (out.volume_error > options.tolerance || out.hausdorff_error > options.tolerance) {
-    auto score = [](const ClumpStep& s) { return std::max(s.volume_error, s.hausdorff_error); };
-    const ClumpStep best = out.history.empty()
-                               ? ClumpStep{}
-                               : *std::min_element(out.history.begin(), out.history.end(),
-                                                   [&](const ClumpStep& a, const ClumpStep& b) {
-                                                     return score(a) < score(b);
-                                                   });
+    auto score = [](const geometry::ClumpStep& s) { return std::max(s.volume_error, s.hausdorff_error); };
+    const geometry::ClumpStep best = out.history.empty()
+                                         ? geometry::ClumpStep{}
+                                         : *std::min_element(out.history.begin(), out.history.end(),
+                                                             [&](const geometry::ClumpStep& a, const geometry::ClumpStep& b) {
+                                                               return score(a) < score(b);
+                                                             });
     const bool stalled = int(out.spheres.size()) < options.max_spheres;
     throw InputError(
         "", "tolerance",
@@ -727,13 +727,13 @@ ClumpTemplate make_clump(const TriMesh& grain, const ClumpOptions& options) {
   return out;
 }
 
-std::string clump_json(const ClumpTemplate& c) {
+std::string clump_json(const geometry::ClumpTemplate& c) {
   nlohmann::ordered_json j;
   j["spheres"] = nlohmann::ordered_json::array();
-  for (const ClumpSphere& s : c.spheres)
+  for (const geometry::ClumpSphere& s : c.spheres)
     j["spheres"].push_back({s.centre.x(), s.centre.y(), s.centre.z(), s.radius});
   j["mesh_volume_m3"] = c.mesh_volume_m3;
-  const Vec3& I = c.inertia_principal_per_density;
+  const geometry::Vec3& I = c.inertia_principal_per_density;
   j["inertia_principal_per_density"] = {I.x(), I.y(), I.z()};
   j["union_volume_m3"] = c.union_volume_m3;
   j["volume_error"] = c.volume_error;
@@ -745,7 +745,7 @@ std::string clump_json(const ClumpTemplate& c) {
   j["rotation"] = nlohmann::ordered_json::array();
   for (int r = 0; r < 3; ++r) j["rotation"].push_back({R(r, 0), R(r, 1), R(r, 2)});
   j["history"] = nlohmann::ordered_json::array();
-  for (const ClumpStep& s : c.history)
+  for (const geometry::ClumpStep& s : c.history)
     j["history"].push_back({{"spheres", s.spheres},
                             {"volume_error", s.volume_error},
                             {"hausdorff_error", s.hausdorff_error}});

@@ -8,21 +8,21 @@
 #include <string>
 #include <vector>
 
-#include "mesh/clump_template.hpp"
-#include "mesh/trimesh.hpp"
+#include "geometry/clump_template.hpp"
+#include "geometry/trimesh.hpp"
 
 namespace mesh {
 
 // Volume, centroid and inertia of a solid of unit density bounded by a closed, outward mesh.
 struct MassProperties {
   double volume = 0.0;                                            // [m³]
-  Vec3 centroid = Vec3::Zero();                                   // [m]
+  geometry::Vec3 centroid = geometry::Vec3::Zero();               // [m]
   Eigen::Matrix3d inertia_per_density = Eigen::Matrix3d::Zero();  // about the centroid [m⁵]
 };
 
 // Exact polyhedral integrals (Eberly, "Polyhedral Mass Properties (Revisited)", 2002): no
 // sampling, exact up to rounding for any closed, outward triangle mesh.
-MassProperties mass_properties(const TriMesh& closed_outward_mesh);
+MassProperties mass_properties(const geometry::TriMesh& closed_outward_mesh);
 
 struct ClumpOptions {
   double tolerance = 0.05;  // both relative errors must reach it
@@ -36,9 +36,9 @@ struct ClumpOptions {
 // Throws diefill::InputError for a mesh that is not closed and outward oriented (run repair
 // first), and when max_spheres spheres cannot reach the tolerance (the message says how far
 // they got).
-ClumpTemplate make_clump(const TriMesh& grain, const ClumpOptions& options);
+geometry::ClumpTemplate make_clump(const geometry::TriMesh& grain, const ClumpOptions& options);
 
 // The template as JSON (docs/INTERFACE.md, "Clump template").
-std::string clump_json(const ClumpTemplate& clump);
+std::string clump_json(const geometry::ClumpTemplate& clump);
 
 }  // namespace mesh

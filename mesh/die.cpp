@@ -69,26 +69,26 @@ MeshReport report_from_json(const json& j) {
 }
 
 // Meshes in the cache are raw doubles and int32 indices: exact, and fast to read back.
-void write_mesh_binary(const TriMesh& m, const fs::path& path) {
+void write_mesh_binary(const geometry::TriMesh& m, const fs::path& path) {
   std::string bytes;
   const std::uint64_t nv = m.vertices.size(), nt = m.triangles.size();
   bytes.append(reinterpret_cast<const char*>(&nv), 8);
   bytes.append(reinterpret_cast<const char*>(&nt), 8);
-  for (const Vec3& v : m.vertices) bytes.append(reinterpret_cast<const char*>(v.data()), 24);
-  for (const Triangle& t : m.triangles) bytes.append(reinterpret_cast<const char*>(t.data()), 12);
+  for (const geometry::Vec3& v : m.vertices) bytes.append(reinterpret_cast<const char*>(v.data()), 24);
+  for (const geometry::Triangle& t : m.triangles) bytes.append(reinterpret_cast<const char*>(t.data()), 12);
   diefill::write_file_atomic(path, bytes);
 }
 
-std::optional<TriMesh> read_mesh_binary(const fs::path& path) {
+std::optional<geometry::TriMesh> read_mesh_binary(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   std::uint64_t nv = 0, nt = 0;
   if (!in.read(reinterpret_cast<char*>(&nv), 8) || !in.read(reinterpret_cast<char*>(&nt), 8))
     return std::nullopt;
-  TriMesh m;
+  geometry::TriMesh m;
   m.vertices.resize(nv);
   m.triangles.resize(nt);
-  for (Vec3& v : m.vertices) in.read(reinterpret_cast<char*>(v.data()), 24);
-  for (Triangle& t : m.triangles) in.read(reinterpret_cast<char*>(t.data()), 12);
+  for (geometry::Vec3& v : m.vertices) in.read(reinterpret_cast<char*>(v.data()), 24);
+  for (geometry::Triangle& t : m.triangles) in.read(reinterpret_cast<char*>(t.data()), 12);
   if (!in) return std::nullopt;
   return m;
 }
@@ -109,9 +109,9 @@ void check_options(const DieOptions& o, const std::string& source) {
 // The part below the parting plane becomes the cavity: the table cuts it at its widest section
 // and the upper punch would form the rest (docs/INTERFACE.md, `die.parting`).
 void cut_at_parting_plane(PreparedDie& die, const std::string& source) {
-  const Box whole = bounding_box(die.cavity);
+  const geometry::Box whole = geometry::bounding_box(die.cavity);
   const double z = *die.parting_z;
-  TriMesh below;
+  geometry::TriMesh below;
   if (!detail::clip_below(die.cavity, z, below))
     throw InputError(source, "die.parting",
                      fmt::format("cutting the part at its widest section, z = {:.4g} mm, did not leave a closed solid",
@@ -128,17 +128,17 @@ void cut_at_parting_plane(PreparedDie& die, const std::string& source) {
 // The `part`-th largest of an assembly's bodies by enclosed volume (1: the largest; ties in the
 // file's order). A die forms one part; an assembly's parts stand apart by clearances no die wall
 // is as thin as (docs/MESHES.md, "Assemblies").
-TriMesh body_of_assembly(std::vector<TriMesh> bodies, int part, const std::string& source) {
+geometry::TriMesh body_of_assembly(std::vector<geometry::TriMesh> bodies, int part, const std::string& source) {
   std::vector<double> volume(bodies.size());
-  std::transform(bodies.begin(), bodies.end(), volume.begin(), [](const TriMesh& b) { return std::abs(signed_volume(b)); });
+  std::transform(bodies.begin(), bodies.end(), volume.begin(), [](const geometry::TriMesh& b) { return std::abs(geometry::signed_volume(b)); });
   std::vector<std::size_t> largest_first(bodies.size());
   std::iota(largest_first.begin(), largest_first.end(), 0);
   std::stable_sort(largest_first.begin(), largest_first.end(), [&](std::size_t a, std::size_t b) { return volume[a] > volume[b]; });
   if (part >= 1 && std::size_t(part) <= bodies.size()) return std::move(bodies[largest_first[std::size_t(part) - 1]]);
   std::string largest;
   for (std::size_t k = 0; k < std::min<std::size_t>(5, bodies.size()); ++k) {
-    const Box box = bounding_box(bodies[largest_first[k]]);
-    const Vec3 size = 1e3 * box.size(), at = 1e3 * box.lo;
+    const geometry::Box box = geometry::bounding_box(bodies[largest_first[k]]);
+    const geometry::Vec3 size = 1e3 * box.size(), at = 1e3 * box.lo;
     largest += fmt::format("{}{}: {:.4g} mm³, {:.3g} x {:.3g} x {:.3g} mm from ({:.4g}, {:.4g}, {:.4g})", k ? "; " : "", k + 1,
                            volume[largest_first[k]] * 1e9, size.x(), size.y(), size.z(), at.x(), at.y(), at.z());
   }
@@ -153,22 +153,13 @@ TriMesh body_of_assembly(std::vector<TriMesh> bodies, int part, const std::strin
 }  // namespace
 
 WallRole parse_role(std::string_view text, std::string_view field) {
-  if (text == "cavity") return WallRole::cavity;
-  if (text == "tool" || text == "solid") return WallRole::tool;
-  if (text == "container") return WallRole::container;
+  if (text == "solid") return WallRole::tool;
+  if (const auto role = diefill::find_choice(wall_roles, text)) return *role;
   throw InputError("", std::string(field), "unknown role '" + std::string(text) + "'",
                    "Use cavity (the part's shape, open at the table), tool (the die body) or "
                    "container (a closed vessel holding the grains)");
 }
 
-std::string_view role_name(WallRole role) {
-  switch (role) {
-    case WallRole::cavity: return "cavity";
-    case WallRole::tool: return "tool";
-    case WallRole::container: return "container";
-  }
-  return "?";
-}
 
 DieOptions die_options_for_grains(double grain_radius_m, double skin_m, std::optional<double> voxel_m) {
   DieOptions o;
@@ -188,7 +179,7 @@ std::string die_cache_key(const DieFile& file, std::optional<double> parting_z, 
   std::string text = fmt::format(
       "format={};sha={};unit={};up={};role={};voxel={:.17g};ext={:.17g};int={:.17g};tol={:.17g};"
       "hole={:.17g};gap={:.17g};wrap={};margin={:.17g}",
-      cache_format, file.sha256, unit_name(o.unit), up_name(file.up), role_name(o.role), o.voxel_m, o.exterior_band_m,
+      cache_format, file.sha256, geometry::unit_name(o.unit), up_name(file.up), role_name(o.role), o.voxel_m, o.exterior_band_m,
       o.interior_band_m, o.repair.tolerance_m, o.repair.max_hole_m, o.repair.closable_gap_m, o.repair.allow_wrap,
       o.table_margin_m);
   if (parting_z) text += fmt::format(";parting={:.17g}", *parting_z);
@@ -199,7 +190,7 @@ std::string die_cache_key(const DieFile& file, std::optional<double> parting_z, 
   return diefill::sha256_hex(text);
 }
 
-DieFile read_die_file(const fs::path& path, std::optional<LengthUnit> unit, std::optional<Up> up, Parting parting, int part) {
+DieFile read_die_file(const fs::path& path, std::optional<geometry::LengthUnit> unit, std::optional<Up> up, Parting parting, int part) {
   DieFile file;
   file.source = path.string();
   file.name = path.stem().string();
@@ -208,7 +199,7 @@ DieFile read_die_file(const fs::path& path, std::optional<LengthUnit> unit, std:
   file.unit = imported.unit;
   file.unit_guessed = imported.unit_guessed;
   // The unit is the file's, guessed from all of it; the opening is the part's own.
-  std::vector<TriMesh> bodies = separate_bodies(imported.mesh);
+  std::vector<geometry::TriMesh> bodies = geometry::separate_bodies(imported.mesh);
   file.bodies = bodies.size();
   file.part = part;
   file.mesh = part == 0 ? std::move(imported.mesh) : body_of_assembly(std::move(bodies), part, file.source);
@@ -298,7 +289,7 @@ PreparedDie prepare_die(const DieFile& file, const DieOptions& options, const st
     throw InputError(source, "units",
                      fmt::format("the die is only {:.4g} mm across, less than 4 voxels of {:.4g} mm "
                                  "(read as {})",
-                                 extent * 1e3, options.voxel_m * 1e3, unit_name(options.unit)),
+                                 extent * 1e3, options.voxel_m * 1e3, geometry::unit_name(options.unit)),
                      "If the file is in metres or inches, declare it (--units m, --units in, or "
                      "units = \"m\" in the scene); otherwise choose a smaller voxel");
 
@@ -309,7 +300,7 @@ PreparedDie prepare_die(const DieFile& file, const DieOptions& options, const st
     out.table_z = tool.table_z;
   } else if (options.role == WallRole::container) {
     out.solid = out.cavity;
-    for (Triangle& t : out.solid.triangles) std::swap(t[1], t[2]);
+    for (geometry::Triangle& t : out.solid.triangles) std::swap(t[1], t[2]);
     out.table_z = out.after.bbox.lo.z();
   } else {
     out.solid = out.cavity;

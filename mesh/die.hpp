@@ -11,15 +11,9 @@
 #include "mesh/repair.hpp"
 #include "mesh/sdf.hpp"
 #include "mesh/tool.hpp"
+#include "mesh/wall_role.hpp"
 
 namespace mesh {
-
-// cavity: the part's shape, open at the die table (the tool is the table minus it);
-// tool: the solid itself (die body, punch, obstacle); container: a closed vessel whose inside
-// holds the grains (the LIGGGHTS benchmark's cylinder).
-enum class WallRole { cavity, tool, container };
-WallRole parse_role(std::string_view text, std::string_view field);
-std::string_view role_name(WallRole role);
 
 // Voxel edge as a fraction of the smallest grain radius. Trilinear interpolation of an exact
 // distance field is exact on flat faces; on the ring's Ø10 mm core its error is h²/(8R) [m],
@@ -28,7 +22,7 @@ std::string_view role_name(WallRole role);
 inline constexpr double default_voxel_fraction = 0.25;
 
 struct DieOptions {
-  LengthUnit unit = LengthUnit::mm;
+  geometry::LengthUnit unit = geometry::LengthUnit::mm;
   WallRole role = WallRole::cavity;
   // The way the opening faces in the file; unset: found (find_opening) for a cavity, +z otherwise.
   std::optional<Up> up;
@@ -46,7 +40,7 @@ struct PreparedDie {
   std::string name;    // file stem
   std::string source;  // path as given
   std::string sha256;  // of the file's bytes
-  LengthUnit unit = LengthUnit::mm;  // the file's
+  geometry::LengthUnit unit = geometry::LengthUnit::mm;  // the file's
   bool unit_guessed = false;         // from its size, not given
   Up up;               // the way its opening faced in the file (now +z)
   bool up_found = false;  // found by looking, not given
@@ -57,8 +51,8 @@ struct PreparedDie {
   bool wrapped = false;
   double hausdorff_m = 0.0;   // existing surface moved by repair [m]
   double bridged_m = 0.0;     // widest gap new surface spans [m]
-  TriMesh cavity;      // repaired mesh as given (the cavity, or the tool for role = tool) [m]
-  TriMesh solid;       // what the powder meets: tool for role = cavity, else the mesh itself
+  geometry::TriMesh cavity;   // repaired mesh as given (the cavity, or the tool for role = tool) [m]
+  geometry::TriMesh solid;    // what the powder meets: tool for role = cavity, else the mesh itself
   double table_z = 0.0;
   SdfGrid sdf;
   bool sdf_from_cache = false;
@@ -71,7 +65,7 @@ struct DieFile {
   std::string name;    // file stem
   std::string source;  // path as given
   std::string sha256;  // of the file's bytes
-  LengthUnit unit = LengthUnit::mm;
+  geometry::LengthUnit unit = geometry::LengthUnit::mm;
   bool unit_guessed = false;  // from its size (guess_unit), not given
   Up up;                  // the way its opening faced in the file; the mesh is turned to face +z
   bool up_found = false;  // found by looking, not given
@@ -84,14 +78,14 @@ struct DieFile {
   // (separate_bodies); `bodies`: how many the file holds.
   int part = 0;
   std::size_t bodies = 0;
-  TriMesh mesh;        // [m], turned: the whole file, or the part chosen
+  geometry::TriMesh mesh;  // [m], turned: the whole file, or the part chosen
 };
 // Reads the file in `unit` (unset: guessed from its size, with a warning), keeps its body `part`
 // (0: all of it) and turns it so that its opening faces +z (`up` unset: find_opening, or
 // lying_flat for a part with no flat face that `parting` lets be cut). Throws InputError for a
 // missing, empty or unreadable file, a part the file does not hold, and a part with no flat face
 // when `parting` is Parting::opening.
-DieFile read_die_file(const std::filesystem::path& path, std::optional<LengthUnit> unit, std::optional<Up> up = Up{},
+DieFile read_die_file(const std::filesystem::path& path, std::optional<geometry::LengthUnit> unit, std::optional<Up> up = Up{},
                       Parting parting = Parting::automatic, int part = 0);
 
 // The `up` to read a die's file with: the options' own, or for a cavity unset (its opening is

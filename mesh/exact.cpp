@@ -16,25 +16,25 @@
 namespace mesh {
 
 struct ExactSurface::Impl {
-  TriMesh mesh;   // double precision copy: distances are computed from it, not from floats
-  Vec3 centre;    // Embree's float buffers hold coordinates relative to it
+  geometry::TriMesh mesh;  // double precision copy: distances are computed from it, not from floats
+  geometry::Vec3 centre;   // Embree's float buffers hold coordinates relative to it
   bool inside_out = false;
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
 
   struct Query {
     const Impl* self;
-    Vec3 point;
-    Vec3 closest;
+    geometry::Vec3 point;
+    geometry::Vec3 closest;
     double distance;
   };
 
   static bool closest_callback(RTCPointQueryFunctionArguments* args) {
     auto* q = static_cast<Query*>(args->userPtr);
-    const TriMesh& m = q->self->mesh;
-    const Triangle& t = m.triangles[args->primID];
-    const Vec3 c = closest_point_on_triangle(q->point, m.vertices[t[0]], m.vertices[t[1]],
-                                             m.vertices[t[2]]);
+    const geometry::TriMesh& m = q->self->mesh;
+    const geometry::Triangle& t = m.triangles[args->primID];
+    const geometry::Vec3 c = closest_point_on_triangle(q->point, m.vertices[t[0]], m.vertices[t[1]],
+                                                       m.vertices[t[2]]);
     const double d = (c - q->point).norm();
     if (d < q->distance) {
       q->distance = d;
@@ -47,7 +47,7 @@ struct ExactSurface::Impl {
   }
 
   // Faces the ray from `origin` crosses (parity is all a closed mesh needs).
-  int crossings(const Vec3& origin, const Vec3& direction) const {
+  int crossings(const geometry::Vec3& origin, const geometry::Vec3& direction) const {
     int count = 0;
     float tnear = 0.0f;
     for (int guard = 0; guard < 100000; ++guard) {
@@ -63,8 +63,8 @@ struct ExactSurface::Impl {
     return count;
   }
 
-  RTCRayHit ray_from(const Vec3& origin, const Vec3& direction, float tnear) const {
-    const Vec3 o = origin - centre;
+  RTCRayHit ray_from(const geometry::Vec3& origin, const geometry::Vec3& direction, float tnear) const {
+    const geometry::Vec3 o = origin - centre;
     RTCRayHit rh{};
     rh.ray.org_x = float(o.x());
     rh.ray.org_y = float(o.y());
@@ -102,7 +102,7 @@ struct ExactSurface::Impl {
   // The faces the ray leaves through (along their outward normal) minus those it enters
   // through, counting every face once (spatial splits may report one twice); nullopt when the ray
   // passes within float rounding of an edge, where that count is not to be trusted.
-  std::optional<int> winding_along(const Vec3& origin, const Vec3& direction) const {
+  std::optional<int> winding_along(const geometry::Vec3& origin, const geometry::Vec3& direction) const {
     AllHits hits;
     rtcInitIntersectContext(&hits.context);
     hits.context.filter = &record_hit;
@@ -113,20 +113,20 @@ struct ExactSurface::Impl {
     hits.faces.erase(std::unique(hits.faces.begin(), hits.faces.end()), hits.faces.end());
     int winding = 0;
     for (const unsigned f : hits.faces) {
-      const Triangle& t = mesh.triangles[f];
-      const Vec3 outward = (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
+      const geometry::Triangle& t = mesh.triangles[f];
+      const geometry::Vec3 outward = (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
       winding += outward.dot(direction) > 0 ? 1 : -1;
     }
     return winding;
   }
 };
 
-ExactSurface::ExactSurface(const TriMesh& mesh) : impl_(std::make_unique<Impl>()) {
+ExactSurface::ExactSurface(const geometry::TriMesh& mesh) : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.mesh = mesh;
-  s.inside_out = signed_volume(mesh) < 0;
-  const Box box = bounding_box(mesh);
-  s.centre = box.empty() ? Vec3::Zero() : Vec3((box.lo + box.hi) / 2);
+  s.inside_out = geometry::signed_volume(mesh) < 0;
+  const geometry::Box box = geometry::bounding_box(mesh);
+  s.centre = box.empty() ? geometry::Vec3::Zero() : geometry::Vec3((box.lo + box.hi) / 2);
   // No thread count: Embree with TBB holds a static tbb::global_control at the count it is given
   // (RenderKit/embree issue 507), and "threads=1" left every later TBB loop of the process (the
   // winding-number band, OpenVDB's SDF build) on one core.
@@ -157,10 +157,10 @@ ExactSurface::~ExactSurface() {
   }
 }
 
-Vec3 ExactSurface::closest_point(const Vec3& p) const {
+geometry::Vec3 ExactSurface::closest_point(const geometry::Vec3& p) const {
   Impl::Query q{impl_.get(), p, p, std::numeric_limits<double>::infinity()};
   RTCPointQuery query{};
-  const Vec3 local = p - impl_->centre;
+  const geometry::Vec3 local = p - impl_->centre;
   query.x = float(local.x());
   query.y = float(local.y());
   query.z = float(local.z());
@@ -172,24 +172,24 @@ Vec3 ExactSurface::closest_point(const Vec3& p) const {
   return q.closest;
 }
 
-double ExactSurface::distance(const Vec3& p) const { return (closest_point(p) - p).norm(); }
+double ExactSurface::distance(const geometry::Vec3& p) const { return (closest_point(p) - p).norm(); }
 
-bool ExactSurface::inside(const Vec3& p) const {
+bool ExactSurface::inside(const geometry::Vec3& p) const {
   // Skew directions, so that no ray runs along a face or through a vertex of axis-aligned meshes.
-  static const Vec3 directions[3] = {Vec3(0.5377, 0.8322, 0.1353).normalized(),
-                                     Vec3(-0.7071, 0.1534, -0.6902).normalized(),
-                                     Vec3(0.2213, -0.6547, 0.7229).normalized()};
+  static const geometry::Vec3 directions[3] = {geometry::Vec3(0.5377, 0.8322, 0.1353).normalized(),
+                                               geometry::Vec3(-0.7071, 0.1534, -0.6902).normalized(),
+                                               geometry::Vec3(0.2213, -0.6547, 0.7229).normalized()};
   int votes = 0;
-  for (const Vec3& d : directions) votes += impl_->crossings(p, d) % 2;
+  for (const geometry::Vec3& d : directions) votes += impl_->crossings(p, d) % 2;
   return (votes >= 2) != impl_->inside_out;
 }
 
-bool ExactSurface::inside_by_ray_majority(const Vec3& p, int rays) const {
+bool ExactSurface::inside_by_ray_majority(const geometry::Vec3& p, int rays) const {
   std::mt19937_64 random(7);
   std::normal_distribution<double> normal;
   int votes = 0;
   for (int r = 0, draws = 0; r < rays; ++draws) {
-    const Vec3 direction = Vec3(normal(random), normal(random), normal(random)).normalized();
+    const geometry::Vec3 direction = geometry::Vec3(normal(random), normal(random), normal(random)).normalized();
     const std::optional<int> winding = impl_->winding_along(p, direction);
     // A ray along an edge is drawn again; after 100 such draws the point lies on the surface
     // itself, where neither answer is wrong.

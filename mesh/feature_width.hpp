@@ -7,7 +7,7 @@
 // edge or a corner of the cavity (walls meeting at 90°) is no feature.
 #include <vector>
 
-#include "mesh/trimesh.hpp"
+#include "geometry/trimesh.hpp"
 
 namespace mesh {
 
@@ -15,7 +15,7 @@ struct FeatureWidths {
   struct Crossing {
     double width = 0;   // [m] between the two wall points
     double volume = 0;  // [m³] of the cavity the crossing stands for
-    Vec3 a, b;          // the wall points
+    geometry::Vec3 a, b;  // the wall points
   };
   std::vector<Crossing> crossings;
   double cavity_volume = 0;  // [m³]
@@ -27,6 +27,6 @@ struct FeatureWidths {
 };
 
 // The cavity (closed, outward; its opening is its faces at `table_z`) sampled every `spacing`.
-FeatureWidths feature_widths(const TriMesh& cavity, double table_z, double spacing);
+FeatureWidths feature_widths(const geometry::TriMesh& cavity, double table_z, double spacing);
 
 }  // namespace mesh

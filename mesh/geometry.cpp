@@ -6,12 +6,12 @@
 
 namespace mesh {
 
-std::vector<Segment> sharp_edges(const TriMesh& mesh, double angle_deg) {
-  std::map<std::pair<int, int>, std::vector<Vec3>> normals_of_edge;
-  for (const Triangle& t : mesh.triangles) {
-    const Vec3 n = (mesh.vertices[t[1]] - mesh.vertices[t[0]])
-                       .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]])
-                       .normalized();
+std::vector<Segment> sharp_edges(const geometry::TriMesh& mesh, double angle_deg) {
+  std::map<std::pair<int, int>, std::vector<geometry::Vec3>> normals_of_edge;
+  for (const geometry::Triangle& t : mesh.triangles) {
+    const geometry::Vec3 n = (mesh.vertices[t[1]] - mesh.vertices[t[0]])
+                                 .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]])
+                                 .normalized();
     for (int k = 0; k < 3; ++k) normals_of_edge[std::minmax(t[k], t[(k + 1) % 3])].push_back(n);
   }
   const double cos_limit = std::cos(angle_deg * std::numbers::pi / 180.0);

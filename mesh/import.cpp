@@ -43,7 +43,7 @@ void check_readable_file(const fs::path& path) {
 void append_node_meshes(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent,
                         ImportResult& result) {
   const aiMatrix4x4 transform = parent * node.mTransformation;
-  TriMesh& out = result.mesh;
+  geometry::TriMesh& out = result.mesh;
   for (unsigned n = 0; n < node.mNumMeshes; ++n) {
     const aiMesh& in = *scene.mMeshes[node.mMeshes[n]];
     const int base = int(out.vertices.size());
@@ -69,7 +69,7 @@ void append_node_meshes(const aiScene& scene, const aiNode& node, const aiMatrix
 
 }  // namespace
 
-std::size_t weld_exact(TriMesh& mesh) {
+std::size_t weld_exact(geometry::TriMesh& mesh) {
   struct Key {
     double x, y, z;
     bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
@@ -91,17 +91,17 @@ std::size_t weld_exact(TriMesh& mesh) {
   std::unordered_map<Key, int, KeyHash> index_of;
   index_of.reserve(mesh.vertices.size());
   std::vector<int> remap(mesh.vertices.size());
-  std::vector<Vec3> kept;
+  std::vector<geometry::Vec3> kept;
   kept.reserve(mesh.vertices.size());
   for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
-    const Vec3& v = mesh.vertices[i];
+    const geometry::Vec3& v = mesh.vertices[i];
     auto [it, inserted] = index_of.try_emplace(Key{v.x(), v.y(), v.z()}, int(kept.size()));
     if (inserted) kept.push_back(v);
     remap[i] = it->second;
   }
   std::size_t removed = mesh.vertices.size() - kept.size();
   mesh.vertices = std::move(kept);
-  for (Triangle& t : mesh.triangles)
+  for (geometry::Triangle& t : mesh.triangles)
     for (int& i : t) i = remap[std::size_t(i)];
   return removed;
 }
@@ -126,22 +126,22 @@ ImportResult import_mesh(const fs::path& path, const ImportOptions& options) {
     throw InputError(path.string(), "triangles", "the file holds no triangles",
                      "Export the solid as a surface mesh");
 
-  for (const Vec3& v : result.mesh.vertices)
+  for (const geometry::Vec3& v : result.mesh.vertices)
     if (!v.allFinite())
       throw InputError(path.string(), "vertices",
                        "a vertex coordinate is not a finite number (NaN or infinity)",
                        "Repair or export the mesh again");
   result.unit_guessed = !options.unit;
-  const double extent_in_file = bounding_box(result.mesh).size().maxCoeff();
-  result.unit = options.unit ? *options.unit : guess_unit(extent_in_file);
-  const double scale = metres_per_unit(result.unit);
-  for (Vec3& v : result.mesh.vertices) v *= scale;
+  const double extent_in_file = geometry::bounding_box(result.mesh).size().maxCoeff();
+  result.unit = options.unit ? *options.unit : geometry::guess_unit(extent_in_file);
+  const double scale = geometry::metres_per_unit(result.unit);
+  for (geometry::Vec3& v : result.mesh.vertices) v *= scale;
   result.vertices_welded = weld_exact(result.mesh);
-  if (result.unit_guessed && result.unit != LengthUnit::mm) {
+  if (result.unit_guessed && result.unit != geometry::LengthUnit::mm) {
     std::string msg = fmt::format(
         "{}: no unit given; the mesh is {:.4g} across in the file's numbers, read as {} ({:.4g} mm across: "
         "docs/MESHES.md, \"Units\"). Declare the unit (--units, or die.units in the scene) if that is wrong",
-        path.string(), extent_in_file, unit_name(result.unit), extent_in_file * scale * 1e3);
+        path.string(), extent_in_file, geometry::unit_name(result.unit), extent_in_file * scale * 1e3);
     diefill::log::write_warning(msg);
     result.warnings.push_back(msg);
   }
@@ -153,26 +153,26 @@ ImportResult import_mesh(const fs::path& path, const ImportOptions& options) {
     std::string msg = fmt::format(
         "{}: the mesh is {:.4g} {} across ({:.4g} m), implausible for a die or grain; "
         "is `units` right (mm, m or in)?",
-        path.string(), extent / scale, unit_name(result.unit), extent);
+        path.string(), extent / scale, geometry::unit_name(result.unit), extent);
     diefill::log::write_warning(msg);
     result.warnings.push_back(msg);
   }
   return result;
 }
 
-void write_stl(const TriMesh& mesh, const fs::path& path, LengthUnit unit,
+void write_stl(const geometry::TriMesh& mesh, const fs::path& path, geometry::LengthUnit unit,
                const std::string& header) {
-  const double scale = 1.0 / metres_per_unit(unit);
+  const double scale = 1.0 / geometry::metres_per_unit(unit);
   std::string bytes(80, ' ');
   std::memcpy(bytes.data(), header.data(), std::min<std::size_t>(80, header.size()));
   auto put = [&bytes](const void* p, std::size_t n) { bytes.append(static_cast<const char*>(p), n); };
   const std::uint32_t count = std::uint32_t(mesh.triangles.size());
   put(&count, 4);
-  for (const Triangle& t : mesh.triangles) {
-    const Vec3& a = mesh.vertices[t[0]];
-    const Vec3& b = mesh.vertices[t[1]];
-    const Vec3& c = mesh.vertices[t[2]];
-    Vec3 n = (b - a).cross(c - a);
+  for (const geometry::Triangle& t : mesh.triangles) {
+    const geometry::Vec3& a = mesh.vertices[t[0]];
+    const geometry::Vec3& b = mesh.vertices[t[1]];
+    const geometry::Vec3& c = mesh.vertices[t[2]];
+    geometry::Vec3 n = (b - a).cross(c - a);
     if (n.norm() > 0) n.normalize();
     float values[12] = {float(n.x()), float(n.y()), float(n.z())};
     for (int k = 0; k < 3; ++k)
@@ -184,15 +184,15 @@ void write_stl(const TriMesh& mesh, const fs::path& path, LengthUnit unit,
   diefill::write_file_atomic(path, bytes);
 }
 
-void write_vtp(const TriMesh& mesh, const fs::path& path, const Vec3& shift) {
+void write_vtp(const geometry::TriMesh& mesh, const fs::path& path, const geometry::Vec3& shift) {
   std::string out = fmt::format(
       "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<PolyData>\n"
       "<Piece NumberOfPoints=\"{}\" NumberOfPolys=\"{}\">\n<Points>\n"
       "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n",
       mesh.vertices.size(), mesh.triangles.size());
-  for (const Vec3& v : mesh.vertices) out += fmt::format("{:.9g} {:.9g} {:.9g}\n", v.x() + shift.x(), v.y() + shift.y(), v.z() + shift.z());
+  for (const geometry::Vec3& v : mesh.vertices) out += fmt::format("{:.9g} {:.9g} {:.9g}\n", v.x() + shift.x(), v.y() + shift.y(), v.z() + shift.z());
   out += "</DataArray>\n</Points>\n<Polys>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (const Triangle& t : mesh.triangles) out += fmt::format("{} {} {}\n", t[0], t[1], t[2]);
+  for (const geometry::Triangle& t : mesh.triangles) out += fmt::format("{} {} {}\n", t[0], t[1], t[2]);
   out += "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
   for (std::size_t k = 1; k <= mesh.triangles.size(); ++k) out += fmt::format("{}\n", 3 * k);
   out += "</DataArray>\n</Polys>\n</Piece>\n</PolyData>\n</VTKFile>\n";

@@ -6,17 +6,17 @@
 #include <string>
 #include <vector>
 
-#include "mesh/trimesh.hpp"
+#include "geometry/trimesh.hpp"
 
 namespace mesh {
 
 struct ImportOptions {
-  std::optional<LengthUnit> unit = LengthUnit::mm;  // unset: guessed from the size (guess_unit), with a warning
+  std::optional<geometry::LengthUnit> unit = geometry::LengthUnit::mm;  // unset: guessed from the size (guess_unit), with a warning
 };
 
 struct ImportResult {
-  TriMesh mesh;                        // metres
-  LengthUnit unit = LengthUnit::mm;    // the file's unit, as given or guessed
+  geometry::TriMesh mesh;                                // metres
+  geometry::LengthUnit unit = geometry::LengthUnit::mm;  // the file's unit, as given or guessed
   bool unit_guessed = false;
   std::string format;                  // file extension as assimp saw it
   int meshes_joined = 0;               // meshes (solids, objects) found in the file
@@ -31,12 +31,12 @@ struct ImportResult {
 ImportResult import_mesh(const std::filesystem::path& path, const ImportOptions& options = {});
 
 // Exact-coordinate weld; returns how many vertices it removed. Keeps triangle order.
-std::size_t weld_exact(TriMesh& mesh);
+std::size_t weld_exact(geometry::TriMesh& mesh);
 
 // Binary STL writer (the format dies/ uses); coordinates written in `unit`.
-void write_stl(const TriMesh& mesh, const std::filesystem::path& path, LengthUnit unit,
+void write_stl(const geometry::TriMesh& mesh, const std::filesystem::path& path, geometry::LengthUnit unit,
                const std::string& header);
 // VTK XML PolyData of the surface in metres, moved by `shift`: what ParaView shows beside grains.
-void write_vtp(const TriMesh& mesh, const std::filesystem::path& path, const Vec3& shift = Vec3::Zero());
+void write_vtp(const geometry::TriMesh& mesh, const std::filesystem::path& path, const geometry::Vec3& shift = geometry::Vec3::Zero());
 
 }  // namespace mesh

@@ -21,9 +21,9 @@ namespace {
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = K::Point_3;
 
-Point to_point(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+Point to_point(const geometry::Vec3& v) { return {v.x(), v.y(), v.z()}; }
 
-bool is_degenerate(const TriMesh& mesh, const Triangle& t) {
+bool is_degenerate(const geometry::TriMesh& mesh, const geometry::Triangle& t) {
   if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) return true;
   return CGAL::collinear(to_point(mesh.vertices[t[0]]), to_point(mesh.vertices[t[1]]),
                          to_point(mesh.vertices[t[2]]));
@@ -42,7 +42,7 @@ struct DisjointSets {
 
 // Edge incidence of an indexed mesh: boundary, non-manifold and inconsistently oriented edges,
 // and shells (components connected through shared edges).
-void count_edges_and_shells(const TriMesh& mesh, MeshReport& report) {
+void count_edges_and_shells(const geometry::TriMesh& mesh, MeshReport& report) {
   struct Incidence {
     int faces = 0;
     int forward = 0;  // triangles running the edge from the smaller to the larger index
@@ -52,7 +52,7 @@ void count_edges_and_shells(const TriMesh& mesh, MeshReport& report) {
   edges.reserve(mesh.triangles.size() * 2);
   DisjointSets sets(mesh.triangles.size());
   for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
-    const Triangle& t = mesh.triangles[f];
+    const geometry::Triangle& t = mesh.triangles[f];
     for (int k = 0; k < 3; ++k) {
       std::uint32_t a = std::uint32_t(t[k]), b = std::uint32_t(t[(k + 1) % 3]);
       if (a == b) continue;
@@ -75,10 +75,10 @@ void count_edges_and_shells(const TriMesh& mesh, MeshReport& report) {
   report.shells = std::size_t(std::count(is_root.begin(), is_root.end(), 1));
 }
 
-std::size_t count_duplicate_faces(const TriMesh& mesh) {
+std::size_t count_duplicate_faces(const geometry::TriMesh& mesh) {
   std::map<std::array<int, 3>, int> seen;
   std::size_t duplicates = 0;
-  for (Triangle t : mesh.triangles) {
+  for (geometry::Triangle t : mesh.triangles) {
     std::sort(t.begin(), t.end());
     if (seen[t]++ > 0) ++duplicates;
   }
@@ -94,9 +94,9 @@ namespace {
 // Whether two triangles whose boxes overlap cross: sharing an edge is a neighbour, touching at
 // one vertex is fine, crossing elsewhere is not (each one's edge opposite the shared vertex is
 // tested against the other triangle).
-bool triangles_cross(const TriMesh& mesh, std::size_t fa, std::size_t fb) {
-  const Triangle& a = mesh.triangles[fa];
-  const Triangle& b = mesh.triangles[fb];
+bool triangles_cross(const geometry::TriMesh& mesh, std::size_t fa, std::size_t fb) {
+  const geometry::Triangle& a = mesh.triangles[fa];
+  const geometry::Triangle& b = mesh.triangles[fb];
   int shared = 0, sa = -1, sb = -1;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
@@ -115,14 +115,14 @@ bool triangles_cross(const TriMesh& mesh, std::size_t fa, std::size_t fb) {
 // the inspection takes 7.3 s with the tests on two. Calls `crossing(fa, fb)` for each crossing
 // pair, one batch's pairs after another, on the calling thread.
 template <class OnCrossing>
-void for_each_crossing_pair(const TriMesh& mesh, OnCrossing crossing) {
+void for_each_crossing_pair(const geometry::TriMesh& mesh, OnCrossing crossing) {
   using BoxHandle = CGAL::Box_intersection_d::Box_with_handle_d<double, 3, std::size_t,
                                                                 CGAL::Box_intersection_d::ID_EXPLICIT>;
   std::vector<BoxHandle> boxes;
   boxes.reserve(mesh.triangles.size());
   for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
     if (is_degenerate(mesh, mesh.triangles[f])) continue;  // reported as degenerate instead
-    const Triangle& t = mesh.triangles[f];
+    const geometry::Triangle& t = mesh.triangles[f];
     CGAL::Bbox_3 b = to_point(mesh.vertices[t[0]]).bbox() + to_point(mesh.vertices[t[1]]).bbox() +
                      to_point(mesh.vertices[t[2]]).bbox();
     boxes.emplace_back(b, f);
@@ -150,13 +150,13 @@ void for_each_crossing_pair(const TriMesh& mesh, OnCrossing crossing) {
 
 }  // namespace
 
-std::size_t count_self_intersections(const TriMesh& mesh) {
+std::size_t count_self_intersections(const geometry::TriMesh& mesh) {
   std::size_t pairs = 0;
   for_each_crossing_pair(mesh, [&](std::size_t, std::size_t) { ++pairs; });
   return pairs;
 }
 
-std::vector<bool> faulty_triangles(const TriMesh& mesh) {
+std::vector<bool> faulty_triangles(const geometry::TriMesh& mesh) {
   std::vector<bool> faulty(mesh.triangles.size(), false);
   for (std::size_t f = 0; f < mesh.triangles.size(); ++f) faulty[f] = is_degenerate(mesh, mesh.triangles[f]);
   for_each_crossing_pair(mesh, [&](std::size_t fa, std::size_t fb) { faulty[fa] = faulty[fb] = true; });
@@ -165,12 +165,12 @@ std::vector<bool> faulty_triangles(const TriMesh& mesh) {
 
 }  // namespace detail
 
-MeshReport inspect(const TriMesh& mesh) {
+MeshReport inspect(const geometry::TriMesh& mesh) {
   MeshReport r;
   r.triangles = mesh.triangles.size();
   r.vertices = mesh.vertices.size();
-  r.bbox = bounding_box(mesh);
-  for (const Triangle& t : mesh.triangles) {
+  r.bbox = geometry::bounding_box(mesh);
+  for (const geometry::Triangle& t : mesh.triangles) {
     if (is_degenerate(mesh, t)) ++r.degenerate_faces;
     r.area_m2 += 0.5 * (mesh.vertices[t[1]] - mesh.vertices[t[0]])
                            .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]])
@@ -180,7 +180,7 @@ MeshReport inspect(const TriMesh& mesh) {
   count_edges_and_shells(mesh, r);
   r.self_intersections = detail::count_self_intersections(mesh);
   r.closed = r.triangles > 0 && r.boundary_edges == 0 && r.non_manifold_edges == 0;
-  r.volume_m3 = signed_volume(mesh);
+  r.volume_m3 = geometry::signed_volume(mesh);
   if (!r.closed) r.orientation = "undefined (open)";
   else if (r.inconsistent_edges > 0) r.orientation = "inconsistent";
   else r.orientation = r.volume_m3 >= 0 ? "outward" : "inward";

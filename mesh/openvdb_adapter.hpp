@@ -4,7 +4,7 @@
 
 #include <mutex>
 
-#include "mesh/trimesh.hpp"
+#include "geometry/trimesh.hpp"
 
 namespace mesh::detail {
 
@@ -15,15 +15,15 @@ inline void initialise_openvdb() {
 
 // Points go to OpenVDB's index space in double precision, without a float copy.
 struct TriMeshAdapter {
-  const TriMesh& mesh;
+  const geometry::TriMesh& mesh;
   double inverse_voxel;
-  Vec3 origin = Vec3::Zero();  // the world point of index (0, 0, 0) [m]
+  geometry::Vec3 origin = geometry::Vec3::Zero();  // the world point of index (0, 0, 0) [m]
   std::size_t polygonCount() const { return mesh.triangles.size(); }
   std::size_t pointCount() const { return mesh.vertices.size(); }
   std::size_t vertexCount(std::size_t) const { return 3; }
   void getIndexSpacePoint(std::size_t n, std::size_t v, openvdb::Vec3d& pos) const {
-    const Vec3& p = mesh.vertices[std::size_t(mesh.triangles[n][v])];
-    const Vec3 q = p - origin;
+    const geometry::Vec3& p = mesh.vertices[std::size_t(mesh.triangles[n][v])];
+    const geometry::Vec3 q = p - origin;
     pos = openvdb::Vec3d(q.x(), q.y(), q.z()) * inverse_voxel;
   }
 };

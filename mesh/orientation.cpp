@@ -23,38 +23,37 @@ constexpr int section_levels = 256;
 
 std::optional<Up> parse_up(std::string_view text, std::string_view field) {
   if (text == "auto") return std::nullopt;
-  if (text.size() == 2 && (text[0] == '+' || text[0] == '-') && text[1] >= 'x' && text[1] <= 'z')
-    return Up{text[1] - 'x', text[0] == '+' ? 1 : -1};
+  if (const auto up = diefill::find_choice(directions, text)) return *up;
   throw diefill::InputError("", std::string(field), "'" + std::string(text) + "' is not a direction",
                             "Give +x, -x, +y, -y, +z, -z (the way the die's opening faces in the file) or auto");
 }
 
-std::string up_name(Up up) { return std::string(up.sign > 0 ? "+" : "-") + char('x' + up.axis); }
+std::string up_name(Up up) { return std::string(diefill::choice_name(directions, up)); }
 
-double opening_area(const TriMesh& mesh, Up up) {
-  const Box box = bounding_box(mesh);
+double opening_area(const geometry::TriMesh& mesh, Up up) {
+  const geometry::Box box = geometry::bounding_box(mesh);
   const double top = up.sign > 0 ? box.hi[up.axis] : -box.lo[up.axis];
   // Within a millionth of the die's size counts as on the extreme (STL stores floats), as tool.cpp.
   const double eps = 1e-6 * box.size().norm();
   double area = 0;
-  for (const Triangle& t : mesh.triangles) {
-    const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
-    const auto at_top = [&](const Vec3& p) { return std::abs(up.sign * p[up.axis] - top) <= eps; };
+  for (const geometry::Triangle& t : mesh.triangles) {
+    const geometry::Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+    const auto at_top = [&](const geometry::Vec3& p) { return std::abs(up.sign * p[up.axis] - top) <= eps; };
     if (!at_top(a) || !at_top(b) || !at_top(c)) continue;
-    const Vec3 n = (b - a).cross(c - a);
+    const geometry::Vec3 n = (b - a).cross(c - a);
     if (up.sign * n[up.axis] > 0) area += 0.5 * n.norm();
   }
   return area;
 }
 
-double shadow_area(const TriMesh& mesh, int axis) {
+double shadow_area(const geometry::TriMesh& mesh, int axis) {
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-  const Box box = bounding_box(mesh);
+  const geometry::Box box = geometry::bounding_box(mesh);
   const double h = std::max(box.size()[u], box.size()[v]) / shadow_cells;
   if (!(h > 0)) return 0;
   const int nu = int(std::ceil(box.size()[u] / h)) + 1, nv = int(std::ceil(box.size()[v] / h)) + 1;
   std::vector<char> covered(std::size_t(nu) * std::size_t(nv), 0);
-  for (const Triangle& t : mesh.triangles) {
+  for (const geometry::Triangle& t : mesh.triangles) {
     const Eigen::Vector2d a(mesh.vertices[t[0]][u], mesh.vertices[t[0]][v]), b(mesh.vertices[t[1]][u], mesh.vertices[t[1]][v]),
         c(mesh.vertices[t[2]][u], mesh.vertices[t[2]][v]);
     const auto cross = [](const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& r) {
@@ -76,7 +75,7 @@ double shadow_area(const TriMesh& mesh, int axis) {
   return double(std::count(covered.begin(), covered.end(), 1)) * h * h;
 }
 
-Up find_opening(const TriMesh& mesh, const std::string& source) {
+Up find_opening(const geometry::TriMesh& mesh, const std::string& source) {
   // How much of the part's outline along the axis a shoe passing over that face reaches; each
   // axis's shadow rasterised once (both of its ends share it), and only where a face asks.
   std::array<std::optional<double>, 3> shadows;
@@ -107,14 +106,14 @@ Up find_opening(const TriMesh& mesh, const std::string& source) {
   return best;
 }
 
-bool has_flat_extreme(const TriMesh& mesh) {
+bool has_flat_extreme(const geometry::TriMesh& mesh) {
   for (int axis = 0; axis < 3; ++axis)
     for (int sign : {1, -1})
       if (opening_area(mesh, Up{axis, sign}) > 0) return true;
   return false;
 }
 
-Up lying_flat(const TriMesh& mesh) {
+Up lying_flat(const geometry::TriMesh& mesh) {
   Up best{};
   double largest = -1;
   for (int axis = 0; axis < 3; ++axis)
@@ -123,19 +122,17 @@ Up lying_flat(const TriMesh& mesh) {
 }
 
 Parting parse_parting(std::string_view text, std::string_view field) {
-  if (text == "auto") return Parting::automatic;
-  if (text == "opening") return Parting::opening;
-  if (text == "widest") return Parting::widest;
+  if (const auto parting = diefill::find_choice(partings, text)) return *parting;
   throw diefill::InputError("", std::string(field), "'" + std::string(text) + "' is not a parting",
                             "Give opening (the table at the part's flat face), widest (at its widest section) or auto");
 }
 
-double section_area(const TriMesh& mesh, double height) {
+double section_area(const geometry::TriMesh& mesh, double height) {
   double twice_area = 0;
-  for (const Triangle& t : mesh.triangles) {
-    const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+  for (const geometry::Triangle& t : mesh.triangles) {
+    const geometry::Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
     // The crossings of the edges whose ends lie on either side (an end on the plane counts as above).
-    std::array<Vec3, 2> crossing;
+    std::array<geometry::Vec3, 2> crossing;
     int found = 0;
     for (const auto& [p, q] : {std::pair{&a, &b}, std::pair{&b, &c}, std::pair{&c, &a}})
       if (((*p).z() < height) != ((*q).z() < height) && found < 2) {
@@ -143,15 +140,15 @@ double section_area(const TriMesh& mesh, double height) {
         crossing[std::size_t(found++)] = *p + s * (*q - *p);
       }
     if (found < 2) continue;
-    const Vec3 along = Vec3::UnitZ().cross((b - a).cross(c - a));
+    const geometry::Vec3 along = geometry::Vec3::UnitZ().cross((b - a).cross(c - a));
     if ((crossing[1] - crossing[0]).dot(along) < 0) std::swap(crossing[0], crossing[1]);
     twice_area += crossing[0].x() * crossing[1].y() - crossing[1].x() * crossing[0].y();
   }
   return 0.5 * twice_area;
 }
 
-double widest_section_z(const TriMesh& mesh) {
-  const Box box = bounding_box(mesh);
+double widest_section_z(const geometry::TriMesh& mesh) {
+  const geometry::Box box = geometry::bounding_box(mesh);
   double best_z = box.hi.z(), largest = -1;
   for (int level = section_levels - 1; level >= 0; --level) {
     const double z = box.lo.z() + (level + 0.5) / section_levels * box.size().z();
@@ -160,13 +157,13 @@ double widest_section_z(const TriMesh& mesh) {
   return best_z;
 }
 
-void turn_up(TriMesh& mesh, Up up) {
+void turn_up(geometry::TriMesh& mesh, Up up) {
   // The up axis becomes z; another axis takes its place, with a sign that keeps the turn proper.
-  for (Vec3& p : mesh.vertices) {
-    const Vec3 q = p;
-    if (up.axis == 2) p = up.sign > 0 ? q : Vec3(q.x(), -q.y(), -q.z());
-    else if (up.axis == 0) p = up.sign > 0 ? Vec3(-q.z(), q.y(), q.x()) : Vec3(q.z(), q.y(), -q.x());
-    else p = up.sign > 0 ? Vec3(q.x(), -q.z(), q.y()) : Vec3(q.x(), q.z(), -q.y());
+  for (geometry::Vec3& p : mesh.vertices) {
+    const geometry::Vec3 q = p;
+    if (up.axis == 2) p = up.sign > 0 ? q : geometry::Vec3(q.x(), -q.y(), -q.z());
+    else if (up.axis == 0) p = up.sign > 0 ? geometry::Vec3(-q.z(), q.y(), q.x()) : geometry::Vec3(q.z(), q.y(), -q.x());
+    else p = up.sign > 0 ? geometry::Vec3(q.x(), -q.z(), q.y()) : geometry::Vec3(q.x(), q.z(), -q.y());
   }
 }
 

@@ -39,52 +39,52 @@ using detail::to_trimesh;
 namespace PMP = CGAL::Polygon_mesh_processing;
 using diefill::InputError;
 
-Point to_point(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+Point to_point(const geometry::Vec3& v) { return {v.x(), v.y(), v.z()}; }
 
 double diameter_of_cycle(const SurfaceMesh& sm, SurfaceMesh::Halfedge_index start) {
-  Box box;
+  geometry::Box box;
   for (auto h : CGAL::halfedges_around_face(start, sm)) {
     const Point& p = sm.point(sm.target(h));
-    box.extend(Vec3(p.x(), p.y(), p.z()));
+    box.extend(geometry::Vec3(p.x(), p.y(), p.z()));
   }
   return box.size().norm();
 }
 
 // Mean thickness 2V/A of a closed surface: a wrap around an open sheet is only about two
 // offsets thick, a real solid is many times thicker.
-double mean_thickness(const TriMesh& mesh) {
+double mean_thickness(const geometry::TriMesh& mesh) {
   double area = 0.0;
-  for (const Triangle& t : mesh.triangles)
+  for (const geometry::Triangle& t : mesh.triangles)
     area += 0.5 * (mesh.vertices[t[1]] - mesh.vertices[t[0]])
                       .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]])
                       .norm();
-  return area > 0 ? 2.0 * std::abs(signed_volume(mesh)) / area : 0.0;
+  return area > 0 ? 2.0 * std::abs(geometry::signed_volume(mesh)) / area : 0.0;
 }
 
 std::string mm(double metres) { return fmt::format("{:.4g} mm", metres * 1e3); }
 
 // Each edge-connected piece of a consistently oriented soup turned so that it encloses positive
 // volume about its own centroid: the winding number counts a piece exported inward as -1.
-TriMesh outward_pieces(SurfaceMesh sm) {
+geometry::TriMesh outward_pieces(SurfaceMesh sm) {
   auto piece = sm.add_property_map<SurfaceMesh::Face_index, std::size_t>("f:piece").first;
   const std::size_t pieces = PMP::connected_components(sm, piece);
-  std::vector<Vec3> sum(pieces, Vec3::Zero());
+  std::vector<geometry::Vec3> sum(pieces, geometry::Vec3::Zero());
   std::vector<double> count(pieces, 0.0), six_volume(pieces, 0.0);
   auto position = [&](SurfaceMesh::Vertex_index v) {
     const Point& p = sm.point(v);
-    return Vec3(p.x(), p.y(), p.z());
+    return geometry::Vec3(p.x(), p.y(), p.z());
   };
   for (auto f : sm.faces())
     for (auto v : CGAL::vertices_around_face(sm.halfedge(f), sm)) sum[piece[f]] += position(v), count[piece[f]] += 1;
   for (auto f : sm.faces()) {
-    const Vec3 centre = sum[piece[f]] / count[piece[f]];
-    std::array<Vec3, 3> corner;
+    const geometry::Vec3 centre = sum[piece[f]] / count[piece[f]];
+    std::array<geometry::Vec3, 3> corner;
     int k = 0;
     for (auto v : CGAL::vertices_around_face(sm.halfedge(f), sm))
       if (k < 3) corner[std::size_t(k++)] = position(v) - centre;
     six_volume[piece[f]] += corner[0].dot(corner[1].cross(corner[2]));
   }
-  TriMesh out = to_trimesh(sm);
+  geometry::TriMesh out = to_trimesh(sm);
   std::size_t f = 0;
   for (auto face : sm.faces()) {
     if (six_volume[piece[face]] < 0) std::swap(out.triangles[f][1], out.triangles[f][2]);
@@ -98,18 +98,18 @@ struct Soup {
   std::vector<Point> points;
   std::vector<std::vector<std::size_t>> polygons;
 };
-Soup soup_of(const TriMesh& mesh) {
+Soup soup_of(const geometry::TriMesh& mesh) {
   Soup soup;
   soup.points.reserve(mesh.vertices.size());
-  for (const Vec3& v : mesh.vertices) soup.points.push_back(to_point(v));
+  for (const geometry::Vec3& v : mesh.vertices) soup.points.push_back(to_point(v));
   soup.polygons.reserve(mesh.triangles.size());
-  for (const Triangle& t : mesh.triangles)
+  for (const geometry::Triangle& t : mesh.triangles)
     soup.polygons.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
   return soup;
 }
 
 // The repaired mesh back in CGAL's form: it came out of a Surface_mesh, so it is a polygon mesh.
-SurfaceMesh polygon_mesh_of(const TriMesh& mesh) {
+SurfaceMesh polygon_mesh_of(const geometry::TriMesh& mesh) {
   SurfaceMesh sm;
   if (!detail::to_surface_mesh(mesh, sm)) throw std::logic_error("repair: a repaired surface is not a polygon mesh");
   return sm;
@@ -124,12 +124,12 @@ constexpr double weld_shares_of_tolerance[] = {1e-3, 1e-2, 1e-1};
 // Step 4 of repair, first choice: the surface with vertices closer than a small weld distance
 // made one, when that leaves it closed, oriented and free of crossings; else empty.
 struct SmallFoldsWelded {
-  TriMesh mesh;
+  geometry::TriMesh mesh;
   double distance_m = 0.0;
   double moved_m = 0.0;
   std::size_t merged = 0;
 };
-std::optional<SmallFoldsWelded> weld_small_folds(const TriMesh& mesh, double tolerance_m) {
+std::optional<SmallFoldsWelded> weld_small_folds(const geometry::TriMesh& mesh, double tolerance_m) {
   for (const double share : weld_shares_of_tolerance) {
     const WeldedMesh welded = weld_close_vertices(mesh, share * tolerance_m);
     if (welded.merged == 0) continue;
@@ -141,7 +141,7 @@ std::optional<SmallFoldsWelded> weld_small_folds(const TriMesh& mesh, double tol
     PMP::remove_degenerate_faces(sm);
     sm.collect_garbage();
     if (!CGAL::is_closed(sm)) continue;
-    TriMesh result = to_trimesh(sm);
+    geometry::TriMesh result = to_trimesh(sm);
     if (detail::count_self_intersections(result) > 0) continue;
     return SmallFoldsWelded{std::move(result), share * tolerance_m, welded.moved_m, welded.merged};
   }
@@ -171,20 +171,20 @@ constexpr double max_wrap_triangles = 3e5;
 // cells of the tolerance. Refused by name where that solid is undefined (too much ambiguous
 // volume); empty where re-meshing would cost too much or move the surface beyond the tolerance,
 // so that the alpha wrap is tried instead.
-std::optional<TriMesh> winding_number_solid(const SurfaceMesh& sm, const MeshReport& before,
-                                            const RepairOptions& options, const std::string& source,
-                                            std::string& defect, RepairResult& result) {
+std::optional<geometry::TriMesh> winding_number_solid(const SurfaceMesh& sm, const MeshReport& before,
+                                                      const RepairOptions& options, const std::string& source,
+                                                      std::string& defect, RepairResult& result) {
   const double cell = options.tolerance_m;
   if (detail::winding_solid_cells(before.area_m2, cell) > max_winding_cells) return std::nullopt;
   diefill::Stopwatch clock;
-  const TriMesh soup = outward_pieces(sm);
+  const geometry::TriMesh soup = outward_pieces(sm);
   const detail::WindingSurvey survey = detail::survey_winding(soup);
   if (survey.solid_cells < min_survey_cells) {
     diefill::log::debug("repair: the winding-number survey resolves the solid in {} cells only", survey.solid_cells);
     return std::nullopt;
   }
   if (survey.ambiguous_volume_m3 > max_ambiguous_share * survey.solid_volume_m3) {
-    const Box& b = survey.ambiguous_box;
+    const geometry::Box& b = survey.ambiguous_box;
     throw InputError(source, "boundary edges",
                      fmt::format("{}; the volume it encloses is undefined: its winding number is "
                                  "neither near 0 nor near 1 in {:.4g} mm³ ({:.3g} % of the {:.4g} mm³ it "
@@ -209,8 +209,8 @@ std::optional<TriMesh> winding_number_solid(const SurfaceMesh& sm, const MeshRep
     return std::nullopt;
   }
   if (solid.mesh.triangles.empty()) return std::nullopt;
-  const auto refused = [&](const std::string& what, const Vec3& where_m, const std::string& there = "") {
-    const Vec3 at = 1e3 * where_m;
+  const auto refused = [&](const std::string& what, const geometry::Vec3& where_m, const std::string& there = "") {
+    const geometry::Vec3 at = 1e3 * where_m;
     defect += fmt::format("; re-meshed on cells of {} as the solid its winding number encloses, it would {} at ({:.4g}, "
                           "{:.4g}, {:.4g}) mm{}",
                           mm(cell), what, at.x(), at.y(), at.z(), there);
@@ -232,14 +232,14 @@ std::optional<TriMesh> winding_number_solid(const SurfaceMesh& sm, const MeshRep
       "{:.3g} % of the solid)",
       defect, mm(cell), survey.ambiguous_volume_m3 * 1e9, 100 * survey.ambiguous_volume_m3 / survey.solid_volume_m3));
   if (solid.gap_closed_m > solid.moved_m) {
-    const Vec3 at = 1e3 * solid.gap_closed_at;
+    const geometry::Vec3 at = 1e3 * solid.gap_closed_at;
     result.actions.push_back(fmt::format(
         "closed gaps of the free space no grain {} across can touch the surface in: their faces lie up to {} from "
         "the result, at ({:.4g}, {:.4g}, {:.4g}) mm",
         mm(options.closable_gap_m), mm(solid.gap_closed_m), at.x(), at.y(), at.z()));
   }
   if (solid.contact_joined_m > solid.moved_m) {
-    const Vec3 at = 1e3 * solid.contact_joined_at;
+    const geometry::Vec3 at = 1e3 * solid.contact_joined_at;
     result.actions.push_back(fmt::format(
         "joined parts in contact (less than {} apart, as an assembly's parts are by their faceting): their faces lie "
         "up to {} inside the result, at ({:.4g}, {:.4g}, {:.4g}) mm",
@@ -251,9 +251,9 @@ std::optional<TriMesh> winding_number_solid(const SurfaceMesh& sm, const MeshRep
 
 // Step 7 of repair, second choice: an alpha wrap within the tolerance (CGAL), refused where the
 // holes are wider than the wrapping ball, wrapping is not allowed, or it would cost too much.
-TriMesh alpha_wrapped(const TriMesh& input, const MeshReport& before, const RepairOptions& options,
-                      const std::string& source, const std::string& defect, bool closed,
-                      double largest_open_hole, RepairResult& result) {
+geometry::TriMesh alpha_wrapped(const geometry::TriMesh& input, const MeshReport& before, const RepairOptions& options,
+                                const std::string& source, const std::string& defect, bool closed,
+                                double largest_open_hole, RepairResult& result) {
   diefill::Stopwatch clock;
   const double alpha = 2.0 * options.tolerance_m;
   const double offset = 0.25 * options.tolerance_m;
@@ -274,7 +274,7 @@ TriMesh alpha_wrapped(const TriMesh& input, const MeshReport& before, const Repa
                                  "{:.3g} million triangles",
                                  defect, mm(options.tolerance_m), expected_triangles / 1e6),
                      "Repair the mesh in CAD, or raise the tolerance (--tolerance)");
-  TriMesh wrapped = detail::alpha_wrap(input, alpha, offset);
+  geometry::TriMesh wrapped = detail::alpha_wrap(input, alpha, offset);
   diefill::log::debug("repair: alpha wrap ({} triangles) done at {:.2f} s", wrapped.triangles.size(),
                       clock.seconds());
   if (wrapped.triangles.empty() || mean_thickness(wrapped) < 10.0 * offset)
@@ -310,11 +310,11 @@ void refuse_what_no_repair_reads(const MeshReport& before, const std::string& so
                      "Invert Faces Orientation) and export it again");
 }
 
-bool same_mesh(const TriMesh& a, const TriMesh& b) { return a.vertices == b.vertices && a.triangles == b.triangles; }
+bool same_mesh(const geometry::TriMesh& a, const geometry::TriMesh& b) { return a.vertices == b.vertices && a.triangles == b.triangles; }
 
 // The surface between repair's steps.
 struct Repairing {
-  TriMesh mesh;
+  geometry::TriMesh mesh;
   SurfaceMesh sm;  // the same surface in CGAL's form
   bool closed = false;
   bool self_intersecting = false;
@@ -325,7 +325,7 @@ struct Repairing {
 };
 
 // Steps 1 to 3 of repair, on the soup and its surface: duplicates, orientation, stitching, holes.
-Repairing repaired_surface(const TriMesh& input, const RepairOptions& options, RepairResult& result) {
+Repairing repaired_surface(const geometry::TriMesh& input, const RepairOptions& options, RepairResult& result) {
   // 1. Soup level: merge duplicate points, drop triangles with repeated vertices, and keep one
   //    of each duplicated triangle (either winding: double-sided surfaces become single).
   auto [points, polygons] = soup_of(input);
@@ -426,17 +426,17 @@ void orient_closed_shells(Repairing& r, const std::string& source, RepairResult&
                                  nested, nesting.size()),
                      "A die cavity or grain must be a solid without voids: remove the inner "
                      "shell(s) in CAD");
-  const double volume_before = signed_volume(r.mesh);
+  const double volume_before = geometry::signed_volume(r.mesh);
   PMP::orient_to_bound_a_volume(r.sm);
   r.mesh = to_trimesh(r.sm);
-  if (signed_volume(r.mesh) != volume_before || result.before.inconsistent_edges > 0)
+  if (geometry::signed_volume(r.mesh) != volume_before || result.before.inconsistent_edges > 0)
     result.actions.push_back("oriented every shell outward");
 }
 
 // 7. Still open or self-intersecting: the solid its winding number encloses, else a wrap, unless
 //    the holes are beyond what a wrap within the tolerance can close, or either would be too fine
 //    to afford.
-void solid_of_a_broken_surface(Repairing& r, const TriMesh& input, const RepairOptions& options,
+void solid_of_a_broken_surface(Repairing& r, const geometry::TriMesh& input, const RepairOptions& options,
                                const std::string& source, RepairResult& result) {
   const MeshReport& before = result.before;
   std::string defect = "the mesh is not a closed solid";
@@ -450,7 +450,7 @@ void solid_of_a_broken_surface(Repairing& r, const TriMesh& input, const RepairO
       crossing > 0)
     parts.push_back(fmt::format("{} pairs of intersecting triangles", crossing));
   if (!parts.empty()) defect += " (" + fmt::format("{}", fmt::join(parts, "; ")) + ")";
-  if (std::optional<TriMesh> solid = winding_number_solid(r.sm, before, options, source, defect, result))
+  if (std::optional<geometry::TriMesh> solid = winding_number_solid(r.sm, before, options, source, defect, result))
     r.mesh = std::move(*solid);
   else
     r.mesh = alpha_wrapped(input, before, options, source, defect, r.closed, r.largest_open_hole, result);
@@ -459,7 +459,7 @@ void solid_of_a_broken_surface(Repairing& r, const TriMesh& input, const RepairO
 
 // How far repair moved the existing surface and how wide a gap new surface spans; refused beyond
 // the tolerance.
-void measure_what_repair_moved(const Repairing& r, const TriMesh& input, const RepairOptions& options,
+void measure_what_repair_moved(const Repairing& r, const geometry::TriMesh& input, const RepairOptions& options,
                                const std::string& source, RepairResult& result) {
   if (r.welded_moved_m && !r.geometry_changed) {
     // Every point of a welded triangle moved no farther than its corners did: no sampling (the
@@ -487,7 +487,7 @@ void measure_what_repair_moved(const Repairing& r, const TriMesh& input, const R
 
 }  // namespace
 
-RepairResult repair(const TriMesh& input, const RepairOptions& options, const std::string& source) {
+RepairResult repair(const geometry::TriMesh& input, const RepairOptions& options, const std::string& source) {
   RepairResult result;
   diefill::Stopwatch clock;
   result.before = inspect(input);
@@ -514,8 +514,8 @@ RepairResult repair(const TriMesh& input, const RepairOptions& options, const st
   return result;
 }
 
-RepairOptions grain_repair_options(const TriMesh& grain, double clump_tolerance) {
-  const double size = bounding_box(grain).size().maxCoeff();
+RepairOptions grain_repair_options(const geometry::TriMesh& grain, double clump_tolerance) {
+  const double size = geometry::bounding_box(grain).size().maxCoeff();
   RepairOptions o;
   o.tolerance_m = 0.1 * clump_tolerance * size;
   o.max_hole_m = 0.1 * size;

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "mesh/trimesh.hpp"
+#include "geometry/trimesh.hpp"
 
 namespace mesh {
 
@@ -24,11 +24,11 @@ struct MeshReport {
   std::string orientation;  // "outward", "inward", "inconsistent" or "undefined (open)"
   double volume_m3 = 0.0;   // signed, by the divergence theorem
   double area_m2 = 0.0;
-  Box bbox;
+  geometry::Box bbox;
 };
 
 // All checks of the report, on a welded mesh as imported.
-MeshReport inspect(const TriMesh& mesh);
+MeshReport inspect(const geometry::TriMesh& mesh);
 
 struct RepairOptions {
   double tolerance_m = 5e-5;      // largest surface displacement repair may introduce
@@ -46,10 +46,10 @@ struct RepairOptions {
 // existing surface by a tenth of what the clump may deviate, and fills holes up to a tenth of
 // the grain's size (a missing face of a decimated scan; the report's `bridged` says how far a
 // patch reaches from the surface around it).
-RepairOptions grain_repair_options(const TriMesh& grain, double clump_tolerance);
+RepairOptions grain_repair_options(const geometry::TriMesh& grain, double clump_tolerance);
 
 struct RepairResult {
-  TriMesh mesh;  // closed, outward, without self-intersections
+  geometry::TriMesh mesh;  // closed, outward, without self-intersections
   MeshReport before, after;
   std::vector<std::string> actions;  // each step that changed something, human readable
   bool repaired = false;             // anything changed at all
@@ -68,7 +68,7 @@ struct RepairResult {
 // Repairs `mesh` or throws diefill::InputError naming `source` and the defect that could not
 // be repaired within the tolerance (an open mesh with large holes, nested shells, a change
 // larger than the tolerance, too few triangles).
-RepairResult repair(const TriMesh& mesh, const RepairOptions& options, const std::string& source);
+RepairResult repair(const geometry::TriMesh& mesh, const RepairOptions& options, const std::string& source);
 
 // A readable multi-line summary (for `diefill sdf` and logs).
 std::string format_report(const MeshReport& report);

@@ -45,12 +45,12 @@ double SdfGrid::background() const { return impl_->grid->background(); }
 std::size_t SdfGrid::active_voxels() const { return impl_->grid->activeVoxelCount(); }
 std::size_t SdfGrid::memory_bytes() const { return impl_->grid->memUsage(); }
 
-Box SdfGrid::active_bounds() const {
-  Box box;
+geometry::Box SdfGrid::active_bounds() const {
+  geometry::Box box;
   const openvdb::CoordBBox b = impl_->grid->evalActiveVoxelBoundingBox();
   const double h = voxel_size();
-  box.extend(Vec3(b.min().x(), b.min().y(), b.min().z()) * h);
-  box.extend(Vec3(b.max().x(), b.max().y(), b.max().z()) * h);
+  box.extend(geometry::Vec3(b.min().x(), b.min().y(), b.min().z()) * h);
+  box.extend(geometry::Vec3(b.max().x(), b.max().y(), b.max().z()) * h);
   return box;
 }
 
@@ -58,10 +58,10 @@ float SdfGrid::voxel_value(int i, int j, int k) const {
   return impl_->grid->getConstAccessor().getValue(openvdb::Coord(i, j, k));
 }
 
-double SdfGrid::sample(const Vec3& p) const {
-  const Vec3 x = p / voxel_size();
+double SdfGrid::sample(const geometry::Vec3& p) const {
+  const geometry::Vec3 x = p / voxel_size();
   const Eigen::Vector3d lower = x.array().floor();
-  const Vec3 f = x - lower;
+  const geometry::Vec3 f = x - lower;
   const int i = int(lower.x()), j = int(lower.y()), k = int(lower.z());
   auto acc = impl_->grid->getConstAccessor();
   double value = 0.0;
@@ -73,8 +73,8 @@ double SdfGrid::sample(const Vec3& p) const {
   return value;
 }
 
-bool SdfGrid::in_band(const Vec3& p) const {
-  const Vec3 x = (p / voxel_size()).array().floor();
+bool SdfGrid::in_band(const geometry::Vec3& p) const {
+  const geometry::Vec3 x = (p / voxel_size()).array().floor();
   auto acc = impl_->grid->getConstAccessor();
   for (int c = 0; c < 8; ++c)
     if (!acc.isValueOn(openvdb::Coord(int(x.x()) + (c >> 2 & 1), int(x.y()) + (c >> 1 & 1),
@@ -83,8 +83,8 @@ bool SdfGrid::in_band(const Vec3& p) const {
   return true;
 }
 
-std::vector<Vec3> SdfGrid::active_voxel_positions(std::size_t stride) const {
-  std::vector<Vec3> out;
+std::vector<geometry::Vec3> SdfGrid::active_voxel_positions(std::size_t stride) const {
+  std::vector<geometry::Vec3> out;
   const double h = voxel_size();
   std::size_t n = 0;
   for (auto it = impl_->grid->cbeginValueOn(); it; ++it) {
@@ -111,8 +111,8 @@ std::vector<SdfLeaf> SdfGrid::leaves() const {
   return out;
 }
 
-WallField SdfGrid::wall_field(const TriMesh& solid) const {
-  WallField w;
+geometry::WallField SdfGrid::wall_field(const geometry::TriMesh& solid) const {
+  geometry::WallField w;
   w.set_surface(solid);
   w.voxel = voxel_size();
   auto band = [&](const char* key) {
@@ -238,18 +238,18 @@ namespace {
 // voxel is therefore recomputed from the closest triangles of its 3x3x3 neighbourhood, each
 // descended to the exact closest point and signed by the angle-weighted pseudo-normal; a second
 // pass lets a correct closest triangle spread to neighbours that had none.
-void make_band_exact(openvdb::FloatGrid& grid, openvdb::Int32Grid& closest, const TriMesh& solid,
+void make_band_exact(openvdb::FloatGrid& grid, openvdb::Int32Grid& closest, const geometry::TriMesh& solid,
                      const SdfGrid& sdf) {
   for (int pass = 0; pass < 2; ++pass) {
-    const WallField field = sdf.wall_field(solid);
+    const geometry::WallField field = sdf.wall_field(solid);
     const double h = field.voxel;
     openvdb::tree::LeafManager<openvdb::FloatTree> leaves(grid.tree());
     leaves.foreach ([&](openvdb::FloatTree::LeafNodeType& leaf, std::size_t) {
       auto* index_leaf = closest.tree().probeLeaf(leaf.origin());
       for (auto it = leaf.beginValueOn(); it; ++it) {
         const openvdb::Coord c = it.getCoord();
-        SurfacePoint best;
-        if (!field.nearest(Vec3(c.x() * h, c.y() * h, c.z() * h), 1, best)) continue;
+        geometry::SurfacePoint best;
+        if (!field.nearest(geometry::Vec3(c.x() * h, c.y() * h, c.z() * h), 1, best)) continue;
         it.setValue(float(best.distance));
         if (index_leaf) index_leaf->setValueOnly(it.pos(), best.triangle);
       }
@@ -259,7 +259,7 @@ void make_band_exact(openvdb::FloatGrid& grid, openvdb::Int32Grid& closest, cons
 
 }  // namespace
 
-SdfGrid build_sdf(const TriMesh& solid, const SdfOptions& options) {
+SdfGrid build_sdf(const geometry::TriMesh& solid, const SdfOptions& options) {
   initialise_openvdb();
   const double h = options.voxel_m;
   auto transform = openvdb::math::Transform::createLinearTransform(h);
@@ -298,7 +298,7 @@ SdfGrid build_sdf(const TriMesh& solid, const SdfOptions& options) {
 
 namespace mesh {
 std::string openvdb_version() { return openvdb::getLibraryVersionString(); }
-WallField contact_wall_field(const TriMesh& solid, double grain_radius) {
+geometry::WallField contact_wall_field(const geometry::TriMesh& solid, double grain_radius) {
   const double voxel = 0.5 * grain_radius;
   return build_sdf(solid, {voxel, 1.5 * grain_radius + voxel, 2 * voxel, false}).wall_field(solid);
 }

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "mesh/trimesh.hpp"
-#include "mesh/wall_field.hpp"
+#include "geometry/trimesh.hpp"
+#include "geometry/wall_field.hpp"
 
 namespace mesh {
 
@@ -40,21 +40,21 @@ class SdfGrid {
   double background() const;          // |distance| OpenVDB reports beyond the band [m]
   std::size_t active_voxels() const;
   std::size_t memory_bytes() const;
-  Box active_bounds() const;          // world bounds of the active voxels [m]
+  geometry::Box active_bounds() const;  // world bounds of the active voxels [m]
 
   // Trilinear distance [m]; ± background outside the band.
-  double sample(const Vec3& p) const;
+  double sample(const geometry::Vec3& p) const;
   // True when all eight corners around p are active, so that sample(p) is a band value.
-  bool in_band(const Vec3& p) const;
+  bool in_band(const geometry::Vec3& p) const;
   // Value at voxel (i, j, k), which sits at world position (i, j, k) * voxel_size.
   float voxel_value(int i, int j, int k) const;
   // World positions of active voxels (every `stride`-th, in a fixed order).
-  std::vector<Vec3> active_voxel_positions(std::size_t stride = 1) const;
+  std::vector<geometry::Vec3> active_voxel_positions(std::size_t stride = 1) const;
   std::vector<SdfLeaf> leaves() const;
 
   // The simulation's wall representation: voxels with distances and closest triangles, plus
   // the surface `solid` the grid was built from.
-  WallField wall_field(const TriMesh& solid) const;
+  geometry::WallField wall_field(const geometry::TriMesh& solid) const;
 
   const std::map<std::string, std::string>& metadata() const;
   void set_metadata(const std::string& key, const std::string& value);
@@ -72,17 +72,17 @@ class SdfGrid {
 
  private:
   std::unique_ptr<Impl> impl_;
-  friend SdfGrid build_sdf(const TriMesh&, const SdfOptions&);
+  friend SdfGrid build_sdf(const geometry::TriMesh&, const SdfOptions&);
 };
 
 // Exact narrow-band distances of a closed, outward-oriented triangle mesh, with the closest
 // triangle of every band voxel. OpenVDB's renormalisation is disabled: it was measured to shift
 // flat-face distances by up to 0.06 voxel.
-SdfGrid build_sdf(const TriMesh& solid, const SdfOptions& options);
+SdfGrid build_sdf(const geometry::TriMesh& solid, const SdfOptions& options);
 
 // The wall field of a solid that grains of largest radius r touch only through exact queries:
 // voxels of r/2 merely seed the search for candidate triangles, and the band reaches a grain
 // centre in contact range plus a skin of r/2 (a shoe, a pedestal, a block).
-WallField contact_wall_field(const TriMesh& solid, double grain_radius);
+geometry::WallField contact_wall_field(const geometry::TriMesh& solid, double grain_radius);
 
 }  // namespace mesh

@@ -14,7 +14,7 @@ constexpr double pi = std::numbers::pi;
 // Quad strip between two outlines of n vertices a and b. Unflipped, the normal is the tangent
 // (counter-clockwise about z) crossed with b - a: away from the axis for a wall from a below to
 // b above, and -z for an annulus from a inside to b outside.
-void add_strip(TriMesh& m, int a, int b, int n, bool flip) {
+void add_strip(geometry::TriMesh& m, int a, int b, int n, bool flip) {
   for (int i = 0; i < n; ++i) {
     const int j = (i + 1) % n;
     if (!flip) {
@@ -28,7 +28,7 @@ void add_strip(TriMesh& m, int a, int b, int n, bool flip) {
 }
 
 // Fan from a centre vertex over a circle; `up` gives a normal along +z.
-void add_fan(TriMesh& m, int centre, int ring, int n, bool up) {
+void add_fan(geometry::TriMesh& m, int centre, int ring, int n, bool up) {
   for (int i = 0; i < n; ++i) {
     const int j = (i + 1) % n;
     if (up) m.triangles.push_back({centre, ring + i, ring + j});
@@ -38,8 +38,8 @@ void add_fan(TriMesh& m, int centre, int ring, int n, bool up) {
 // A cavity whose outline (counter-clockwise, star-shaped about the z axis: its polar angle rises
 // along it) is extruded from z = -depth to the table at z = 0: caps fanned from the axis, each
 // side segment one full-height quad.
-TriMesh extruded_cavity(const std::vector<Eigen::Vector2d>& outline, double depth) {
-  TriMesh m;
+geometry::TriMesh extruded_cavity(const std::vector<Eigen::Vector2d>& outline, double depth) {
+  geometry::TriMesh m;
   const int n = int(outline.size());
   for (const double z : {-depth, 0.0})
     for (const Eigen::Vector2d& p : outline) m.vertices.emplace_back(p.x(), p.y(), z);
@@ -57,8 +57,8 @@ TriMesh extruded_cavity(const std::vector<Eigen::Vector2d>& outline, double dept
 // A cavity between an outer and an inner outline of as many points, each point of one at the
 // polar angle of the same point of the other (both counter-clockwise and star-shaped about the z
 // axis), extruded from z = -depth to the table at z = 0: the part of a hub around a core rod.
-TriMesh extruded_annulus(const std::vector<Eigen::Vector2d>& outer, const std::vector<Eigen::Vector2d>& inner, double depth) {
-  TriMesh m;
+geometry::TriMesh extruded_annulus(const std::vector<Eigen::Vector2d>& outer, const std::vector<Eigen::Vector2d>& inner, double depth) {
+  geometry::TriMesh m;
   const int n = int(outer.size());
   const auto add_outline = [&](const std::vector<Eigen::Vector2d>& outline, double z) {
     const int first = int(m.vertices.size());
@@ -166,16 +166,16 @@ int circle_segments(double radius, double chord_tolerance) {
   return std::max(8, (n + 7) / 8 * 8);
 }
 
-TriMesh ring_cavity(double outer_diameter, double inner_diameter, double depth,
-                    double chord_tolerance) {
+geometry::TriMesh ring_cavity(double outer_diameter, double inner_diameter, double depth,
+                              double chord_tolerance) {
   const double ro = outer_diameter / 2, ri = inner_diameter / 2;
   const int n = circle_segments(ro, chord_tolerance);
   if (ri <= 0) return extruded_cavity(circle_outline(ro, n), depth);
   return extruded_annulus(circle_outline(ro, n), circle_outline(ri, n), depth);
 }
 
-TriMesh box_solid(const Vec3& lo, const Vec3& hi) {
-  TriMesh m;
+geometry::TriMesh box_solid(const geometry::Vec3& lo, const geometry::Vec3& hi) {
+  geometry::TriMesh m;
   for (int i = 0; i < 8; ++i)
     m.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
   // Each face as a quad, counter-clockwise seen from outside.
@@ -188,8 +188,8 @@ TriMesh box_solid(const Vec3& lo, const Vec3& hi) {
   return m;
 }
 
-TriMesh revolved_solid(const std::vector<std::array<double, 2>>& profile, int segments) {
-  TriMesh m;
+geometry::TriMesh revolved_solid(const std::vector<std::array<double, 2>>& profile, int segments) {
+  geometry::TriMesh m;
   const int n = int(profile.size());
   for (const auto& [r, z] : profile)
     for (int j = 0; j < segments; ++j) {
@@ -208,9 +208,9 @@ TriMesh revolved_solid(const std::vector<std::array<double, 2>>& profile, int se
   return m;
 }
 
-TriMesh shoe_solid(double inner_length, double inner_width, double height, double thickness) {
+geometry::TriMesh shoe_solid(double inner_length, double inner_width, double height, double thickness) {
   // A rectangular tube: outer and inner rectangles at z = 0 and z = height, joined.
-  TriMesh m;
+  geometry::TriMesh m;
   const double ix = inner_length / 2, iy = inner_width / 2, ox = ix + thickness, oy = iy + thickness;
   const double xs[2][4] = {{-ox, ox, ox, -ox}, {-ix, ix, ix, -ix}};
   const double ys[2][4] = {{-oy, -oy, oy, oy}, {-iy, -iy, iy, iy}};
@@ -235,7 +235,7 @@ TriMesh shoe_solid(double inner_length, double inner_width, double height, doubl
 std::vector<std::string> bundled_die_names() { return {"disc", "ring"}; }
 std::vector<std::string> generated_die_names() { return {"disc", "gear", "ring", "slot", "spline"}; }
 
-TriMesh bundled_die(const std::string& name) {
+geometry::TriMesh bundled_die(const std::string& name) {
   // Chord error 5 µm: half the 0.01 mm the dies must meet.
   constexpr double chord = 5e-6;
   if (name == "disc") return ring_cavity(20e-3, 0.0, 10e-3, chord);

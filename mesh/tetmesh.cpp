@@ -44,24 +44,24 @@ using Criteria = CGAL::Mesh_criteria_3<Tr>;
 template <class Cell>
 bool is_flat_boundary_cell(const C3t3& c3t3, const Cell& c) {
   const Tr& tr = c3t3.triangulation();
-  std::array<Vec3, 4> p;
+  std::array<geometry::Vec3, 4> p;
   double longest = 0;
   for (int k = 0; k < 4; ++k) {
     const Point q = tr.geom_traits().construct_point_3_object()(tr.point(c, k));
-    p[std::size_t(k)] = Vec3(q.x(), q.y(), q.z());
+    p[std::size_t(k)] = geometry::Vec3(q.x(), q.y(), q.z());
   }
   for (int a = 0; a < 4; ++a)
     for (int b = a + 1; b < 4; ++b) longest = std::max(longest, (p[a] - p[b]).norm());
   // Rounding of the coordinates: 1e-12 of the longest edge's cube (the gear's: 1e-19).
-  if (std::abs(tet_volume(p[0], p[1], p[2], p[3])) > 1e-12 * longest * longest * longest) return false;
+  if (std::abs(geometry::tet_volume(p[0], p[1], p[2], p[3])) > 1e-12 * longest * longest * longest) return false;
   int boundary_faces = 0;
   for (int k = 0; k < 4; ++k) boundary_faces += c3t3.is_in_complex(c->neighbor(k)) ? 0 : 1;
   return boundary_faces >= 2;
 }
 
 // One closed, oriented surface without degenerate faces or crossings (repair's checks), or none.
-std::optional<TriMesh> clean_single_body(const TriMesh& mesh) {
-  std::vector<TriMesh> parts = separate_bodies(mesh);  // also drops unused vertices
+std::optional<geometry::TriMesh> clean_single_body(const geometry::TriMesh& mesh) {
+  std::vector<geometry::TriMesh> parts = geometry::separate_bodies(mesh);  // also drops unused vertices
   if (parts.size() != 1) return std::nullopt;
   const MeshReport report = inspect(parts.front());
   if (!report.closed || report.inconsistent_edges > 0 || report.degenerate_faces > 0 || report.self_intersections > 0)
@@ -77,16 +77,16 @@ std::optional<TriMesh> clean_single_body(const TriMesh& mesh) {
 // blade, at two faces of its cut), a collapse can fold one through the other: the vertices
 // around each crossing face (its box grown by `length`) are then kept as they are and the
 // collapse is done again from the start, a few times at most.
-std::optional<TriMesh> with_short_edges_collapsed(const TriMesh& body, double length) {
+std::optional<geometry::TriMesh> with_short_edges_collapsed(const geometry::TriMesh& body, double length) {
   constexpr int attempts = 4;
-  std::vector<Box> keep_within;
+  std::vector<geometry::Box> keep_within;
   for (int attempt = 0; attempt < attempts; ++attempt) {
     SurfaceMesh sm;
     if (!detail::to_surface_mesh(body, sm)) return std::nullopt;
     auto is_kept = sm.add_property_map<SurfaceMesh::Vertex_index, bool>("v:kept", false).first;
     for (const SurfaceMesh::Vertex_index v : sm.vertices()) {
-      const Vec3 p(sm.point(v).x(), sm.point(v).y(), sm.point(v).z());
-      is_kept[v] = std::any_of(keep_within.begin(), keep_within.end(), [&](const Box& b) {
+      const geometry::Vec3 p(sm.point(v).x(), sm.point(v).y(), sm.point(v).z());
+      is_kept[v] = std::any_of(keep_within.begin(), keep_within.end(), [&](const geometry::Box& b) {
         return (p.array() >= b.lo.array()).all() && (p.array() <= b.hi.array()).all();
       });
     }
@@ -94,14 +94,14 @@ std::optional<TriMesh> with_short_edges_collapsed(const TriMesh& body, double le
     CGAL::Polygon_mesh_processing::experimental::remove_almost_degenerate_faces(
         sm, cap_cosine, 1.0, length,
         CGAL::parameters::flip_triangle_height_threshold(length).vertex_is_constrained_map(is_kept));
-    TriMesh collapsed = detail::to_trimesh(sm);
+    geometry::TriMesh collapsed = detail::to_trimesh(sm);
     const std::vector<bool> faulty = detail::faulty_triangles(collapsed);
     if (std::find(faulty.begin(), faulty.end(), true) == faulty.end()) return clean_single_body(collapsed);
     for (std::size_t f = 0; f < faulty.size(); ++f) {
       if (!faulty[f]) continue;
-      Box b;
+      geometry::Box b;
       for (const int v : collapsed.triangles[f]) b.extend(collapsed.vertices[std::size_t(v)]);
-      keep_within.push_back({b.lo - Vec3::Constant(length), b.hi + Vec3::Constant(length)});
+      keep_within.push_back({b.lo - geometry::Vec3::Constant(length), b.hi + geometry::Vec3::Constant(length)});
     }
   }
   return std::nullopt;
@@ -117,15 +117,15 @@ std::optional<TriMesh> with_short_edges_collapsed(const TriMesh& body, double le
 // it is, the short edges collapsed and the flat caps flipped along the surface (the flanged
 // ring's re-mesh has caps 0.1 µm high, which welding leaves). The mesh's boundary may lie the
 // facet distance from the surface anyway.
-TriMesh without_edges_shorter_than(const TriMesh& body, double length) {
-  std::optional<TriMesh> welded;
+geometry::TriMesh without_edges_shorter_than(const geometry::TriMesh& body, double length) {
+  std::optional<geometry::TriMesh> welded;
   if (const WeldedMesh w = weld_close_vertices(body, length); w.merged > 0) welded = clean_single_body(w.mesh);
-  const TriMesh& base = welded ? *welded : body;
-  if (std::optional<TriMesh> clean = with_short_edges_collapsed(base, length)) return std::move(*clean);
+  const geometry::TriMesh& base = welded ? *welded : body;
+  if (std::optional<geometry::TriMesh> clean = with_short_edges_collapsed(base, length)) return std::move(*clean);
   return base;
 }
 
-TetMesh tetrahedralise_body(const TriMesh& body, const TetMeshOptions& o) {
+geometry::TetMesh tetrahedralise_body(const geometry::TriMesh& body, const TetMeshOptions& o) {
   SurfaceMesh sm;
   // In the child process (tetrahedralise): its failure is reported with the remedy there.
   if (!detail::to_surface_mesh(without_edges_shorter_than(body, o.facet_distance_m), sm))
@@ -143,7 +143,7 @@ TetMesh tetrahedralise_body(const TriMesh& body, const TetMeshOptions& o) {
   C3t3 c3t3 = CGAL::make_mesh_3<C3t3>(domain, criteria, params::perturb(params::time_limit = 0),
                                       params::exude(params::time_limit = 0));
 
-  TetMesh out;
+  geometry::TetMesh out;
   std::map<Tr::Vertex_handle, int> index;
   const Tr& tr = c3t3.triangulation();
   auto node = [&](Tr::Vertex_handle v) {
@@ -172,15 +172,15 @@ TetMesh tetrahedralise_body(const TriMesh& body, const TetMeshOptions& o) {
 // edges apart, so edges of two bodies 0.11 mm apart (the teeth of the planetary gear set's
 // gears, where they mesh) shrank the balls and the elements around them to that gap, and the
 // gear set's mesh had not ended after 8 minutes (docs/MESHES.md, "Shared dies through the pipeline").
-TetMesh tetrahedralise_here(const TriMesh& surface, const TetMeshOptions& o) {
-  const std::vector<TriMesh> bodies = separate_bodies(surface);
+geometry::TetMesh tetrahedralise_here(const geometry::TriMesh& surface, const TetMeshOptions& o) {
+  const std::vector<geometry::TriMesh> bodies = geometry::separate_bodies(surface);
   if (bodies.size() == 1) return tetrahedralise_body(surface, o);  // as given, vertex order and all
-  TetMesh out;
-  for (const TriMesh& body : bodies) {
-    const TetMesh part = tetrahedralise_body(body, o);
+  geometry::TetMesh out;
+  for (const geometry::TriMesh& body : bodies) {
+    const geometry::TetMesh part = tetrahedralise_body(body, o);
     const int offset = int(out.nodes.size());
     out.nodes.insert(out.nodes.end(), part.nodes.begin(), part.nodes.end());
-    for (Tet t : part.tets) {
+    for (geometry::Tet t : part.tets) {
       for (int& n : t) n += offset;
       out.tets.push_back(t);
     }
@@ -194,19 +194,19 @@ TetMesh tetrahedralise_here(const TriMesh& surface, const TetMeshOptions& o) {
 
 // In a child process (core/child_process.hpp): a large part can take Mesh_3 many minutes, and
 // the user must hear from it and be able to stop it without losing the fill.
-TetMesh tetrahedralise(const TriMesh& surface, const TetMeshOptions& o, const std::string& source,
-                       const diefill::ChildWait& wait) {
+geometry::TetMesh tetrahedralise(const geometry::TriMesh& surface, const TetMeshOptions& o, const std::string& source,
+                                 const diefill::ChildWait& wait) {
   if (!(o.element_size_m > 0) || !(o.facet_distance_m > 0))
     throw diefill::InputError(source, "fem.element_size", "element size and facet distance must be positive",
                               "Give a positive element size");
   const diefill::ChildResult child = diefill::run_in_child(
       [&] {
-        const TetMesh m = tetrahedralise_here(surface, o);
+        const geometry::TetMesh m = tetrahedralise_here(surface, o);
         return diefill::ByteWriter().put(m.nodes).put(m.tets).put(m.feature_edges).put(m.dropped_boundary_slivers).take();
       },
       wait);
   if (child.outcome == diefill::ChildOutcome::stopped) throw TetMeshingStopped();
-  TetMesh out;
+  geometry::TetMesh out;
   diefill::ByteReader in(child.bytes);
   in.get(out.nodes);
   in.get(out.tets);

@@ -57,14 +57,14 @@ void mark_nesting(Cdt& cdt) {
 }
 }  // namespace
 
-TableExtent table_around(const TriMesh& cavity, double margin) {
-  const Box b = bounding_box(cavity);
+TableExtent table_around(const geometry::TriMesh& cavity, double margin) {
+  const geometry::Box b = geometry::bounding_box(cavity);
   return {b.lo.x() - margin, b.lo.y() - margin, b.hi.x() + margin, b.hi.y() + margin, margin};
 }
 
-ToolMesh tool_from_cavity(const TriMesh& cavity, const TableExtent& table, const std::string& source) {
+ToolMesh tool_from_cavity(const geometry::TriMesh& cavity, const TableExtent& table, const std::string& source) {
   using diefill::InputError;
-  const Box box = bounding_box(cavity);
+  const geometry::Box box = geometry::bounding_box(cavity);
   ToolMesh out;
   out.table_z = box.hi.z();
   // Heights within a millionth of the die's size count as on the table (STL stores floats).
@@ -72,12 +72,12 @@ ToolMesh tool_from_cavity(const TriMesh& cavity, const TableExtent& table, const
 
   // Cavity faces on the table with an upward normal form the opening; the rest become tool
   // walls, reversed because the tool lies on the other side of them.
-  TriMesh& tool = out.mesh;
+  geometry::TriMesh& tool = out.mesh;
   tool.vertices = cavity.vertices;
-  for (const Triangle& t : cavity.triangles) {
-    const Vec3& a = cavity.vertices[t[0]];
-    const Vec3& b = cavity.vertices[t[1]];
-    const Vec3& c = cavity.vertices[t[2]];
+  for (const geometry::Triangle& t : cavity.triangles) {
+    const geometry::Vec3& a = cavity.vertices[t[0]];
+    const geometry::Vec3& b = cavity.vertices[t[1]];
+    const geometry::Vec3& c = cavity.vertices[t[2]];
     const bool on_table = std::abs(a.z() - out.table_z) <= eps &&
                           std::abs(b.z() - out.table_z) <= eps &&
                           std::abs(c.z() - out.table_z) <= eps;
@@ -99,14 +99,14 @@ ToolMesh tool_from_cavity(const TriMesh& cavity, const TableExtent& table, const
 
   // The rim: edges of the remaining walls used by one triangle only.
   std::map<std::pair<int, int>, int> edge_use;
-  for (const Triangle& t : tool.triangles)
+  for (const geometry::Triangle& t : tool.triangles)
     for (int k = 0; k < 3; ++k) ++edge_use[std::minmax(t[k], t[(k + 1) % 3])];
   Cdt cdt;
   std::map<int, Cdt::Vertex_handle> handle_of;
   auto insert = [&](int index) {
     auto it = handle_of.find(index);
     if (it != handle_of.end()) return it->second;
-    const Vec3& p = tool.vertices[index];
+    const geometry::Vec3& p = tool.vertices[index];
     auto h = cdt.insert(K::Point_2(p.x(), p.y()));
     h->info() = index;
     return handle_of[index] = h;
@@ -136,7 +136,7 @@ ToolMesh tool_from_cavity(const TriMesh& cavity, const TableExtent& table, const
   mark_nesting(cdt);
   for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
     if (!f->info().in_domain()) continue;
-    Triangle t{f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()};
+    geometry::Triangle t{f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()};
     tool.triangles.push_back(t);  // counter-clockwise in xy: normal +z
   }
   // Sides (outward) and bottom (normal -z) of the block.

@@ -4,7 +4,7 @@
 // a closed mesh over a finite table, so that its signed distance is exact at the rim edges too.
 #include <string>
 
-#include "mesh/trimesh.hpp"
+#include "geometry/trimesh.hpp"
 
 namespace mesh {
 
@@ -14,7 +14,7 @@ struct TableExtent {
 };
 
 struct ToolMesh {
-  TriMesh mesh;            // closed, outward
+  geometry::TriMesh mesh;  // closed, outward
   double table_z = 0.0;    // [m] height of the die table (the cavity's top face)
   std::size_t opening_faces = 0;  // cavity faces removed to open it at the table
 };
@@ -22,9 +22,9 @@ struct ToolMesh {
 // The table is the cavity's highest z; the faces lying there (normal +z) are its opening.
 // Throws InputError naming `source` when the cavity has no flat top face or the table does not
 // contain the opening.
-ToolMesh tool_from_cavity(const TriMesh& cavity, const TableExtent& table, const std::string& source);
+ToolMesh tool_from_cavity(const geometry::TriMesh& cavity, const TableExtent& table, const std::string& source);
 
 // A table rectangle `margin` wider than the cavity on every side.
-TableExtent table_around(const TriMesh& cavity, double margin);
+TableExtent table_around(const geometry::TriMesh& cavity, double margin);
 
 }  // namespace mesh

@@ -19,13 +19,13 @@ namespace mesh::detail {
 namespace {
 namespace PMP = CGAL::Polygon_mesh_processing;
 
-bool union_in_this_process(const TriMesh& closed_shells, UnionResult& out) {
+bool union_in_this_process(const geometry::TriMesh& closed_shells, UnionResult& out) {
   SurfaceMesh all;
   if (!to_surface_mesh(closed_shells, all)) {
     diefill::log::debug("union: the surface is not a polygon mesh");
     return false;
   }
-  const double scale = mesh::bounding_box(closed_shells).size().maxCoeff();
+  const double scale = geometry::bounding_box(closed_shells).size().maxCoeff();
   std::vector<SurfaceMesh> split, shells;
   PMP::split_connected_components(all, split);
   out.moved_m = 0;
@@ -51,8 +51,8 @@ bool union_in_this_process(const TriMesh& closed_shells, UnionResult& out) {
     // A shell folded through itself (a decimated scan) is re-meshed where it folds: that moves
     // surface, measured against the shell as it was, on the faces left outside the result.
     if (PMP::does_self_intersect(s)) {
-      const TriMesh folded = to_trimesh(s);
-      TriMesh unfolded = folded;
+      const geometry::TriMesh folded = to_trimesh(s);
+      geometry::TriMesh unfolded = folded;
       SurfaceMesh fixed;
       if (!remove_folds(unfolded) || !to_surface_mesh(unfolded, fixed)) {
         diefill::log::debug("union: the folds of a shell of {} faces could not be removed", s.number_of_faces());
@@ -92,7 +92,7 @@ bool union_in_this_process(const TriMesh& closed_shells, UnionResult& out) {
 // Corefinement runs in a child process: CGAL checks its preconditions only in debug builds, and
 // some meshes that pass every check we can make still crash it (3DSMaxExport.stl of the shared
 // broken meshes). A crash there must cost the union, not the user's run.
-bool union_of_shells(const TriMesh& closed_shells, UnionResult& out) {
+bool union_of_shells(const geometry::TriMesh& closed_shells, UnionResult& out) {
   const diefill::ChildResult child = diefill::run_in_child([&] {
     UnionResult united;
     const std::uint64_t ok = union_in_this_process(closed_shells, united) ? 1 : 0;
@@ -123,7 +123,7 @@ bool union_of_shells(const TriMesh& closed_shells, UnionResult& out) {
   return true;
 }
 
-bool clip_below(const TriMesh& closed, double height, TriMesh& out) {
+bool clip_below(const geometry::TriMesh& closed, double height, geometry::TriMesh& out) {
   SurfaceMesh sm;
   if (!to_surface_mesh(closed, sm) || !CGAL::is_closed(sm)) return false;
   // The plane's negative side is kept: below z = height.

@@ -22,13 +22,13 @@ class SegmentProximity {
       const double length = (seg.b - seg.a).norm();
       const int steps = std::max(1, int(std::ceil(length / (0.5 * radius_))));
       for (int k = 0; k <= steps; ++k) {
-        const Vec3 p = seg.a + (seg.b - seg.a) * (double(k) / steps);
+        const geometry::Vec3 p = seg.a + (seg.b - seg.a) * (double(k) / steps);
         auto& bucket = cells_[key(cell_of(p))];
         if (bucket.empty() || bucket.back() != s) bucket.push_back(s);
       }
     }
   }
-  bool near(const Vec3& p) const {
+  bool near(const geometry::Vec3& p) const {
     const auto c = cell_of(p);
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
@@ -42,7 +42,7 @@ class SegmentProximity {
   }
 
  private:
-  std::array<std::int64_t, 3> cell_of(const Vec3& p) const {
+  std::array<std::int64_t, 3> cell_of(const geometry::Vec3& p) const {
     return {std::int64_t(std::floor(p.x() / radius_)), std::int64_t(std::floor(p.y() / radius_)),
             std::int64_t(std::floor(p.z() / radius_))};
   }
@@ -56,7 +56,7 @@ class SegmentProximity {
 };
 
 // Points within two voxels of the sharp edges, uniform along them (SdfVerification).
-void verify_beside_sharp_edges(const WallField& field, const ExactSurface& exact, const std::vector<Segment>& edges,
+void verify_beside_sharp_edges(const geometry::WallField& field, const ExactSurface& exact, const std::vector<Segment>& edges,
                                std::size_t samples, std::mt19937_64& rng, SdfVerification& out) {
   std::vector<double> running;
   double length = 0;
@@ -70,17 +70,17 @@ void verify_beside_sharp_edges(const WallField& field, const ExactSurface& exact
     const std::size_t k = std::min(edges.size() - 1, std::size_t(std::upper_bound(running.begin(), running.end(), at) - running.begin()));
     const Segment& e = edges[k];
     const double start = k == 0 ? 0.0 : running[k - 1];
-    const Vec3 on_edge = e.a + (e.b - e.a) * ((at - start) / std::max(1e-300, running[k] - start));
-    const Vec3 direction(unit(rng), unit(rng), unit(rng));
+    const geometry::Vec3 on_edge = e.a + (e.b - e.a) * ((at - start) / std::max(1e-300, running[k] - start));
+    const geometry::Vec3 direction(unit(rng), unit(rng), unit(rng));
     if (direction.norm() < 1e-3) continue;
-    const Vec3 p = on_edge + reach(rng) * direction.normalized();
+    const geometry::Vec3 p = on_edge + reach(rng) * direction.normalized();
     const double reference = exact.signed_distance(p);
     if (std::abs(reference) <= 0.5 * h) continue;
     ++out.sharp_samples;
     const bool inside = reference < 0;
     bool wrong = (field.signed_distance(p) < 0) != inside;
     out.sharp_sign_disagreements += wrong;
-    SurfacePoint contacts[4];
+    geometry::SurfacePoint contacts[4];
     const int count = field.local_minima(p, 2.0 * h, contacts, 4);
     for (int c = 0; c < count; ++c)
       if ((contacts[c].distance < 0) != inside) ++out.sharp_contact_sign_disagreements, wrong = true;
@@ -90,7 +90,7 @@ void verify_beside_sharp_edges(const WallField& field, const ExactSurface& exact
 
 }  // namespace
 
-SdfVerification verify_sdf(const WallField& field, const TriMesh& mesh, const ExactSurface& exact,
+SdfVerification verify_sdf(const geometry::WallField& field, const geometry::TriMesh& mesh, const ExactSurface& exact,
                            std::size_t samples, std::uint64_t seed, double sharp_angle_deg) {
   SdfVerification out;
   const double h = field.voxel;
@@ -124,9 +124,9 @@ SdfVerification verify_sdf(const WallField& field, const TriMesh& mesh, const Ex
     std::size_t skip = index - (b == 0 ? 0 : running[b - 1]);
     for (std::size_t n = 0; n < 512; ++n)
       if (field.closest[std::size_t(bricks[b].brick) * 512 + n] >= 0 && skip-- == 0)
-        return Vec3(h * (bricks[b].origin[0] + int(n >> 6)), h * (bricks[b].origin[1] + int(n >> 3 & 7)),
-                    h * (bricks[b].origin[2] + int(n & 7)));
-    return Vec3(Vec3::Zero());
+        return geometry::Vec3(h * (bricks[b].origin[0] + int(n >> 6)), h * (bricks[b].origin[1] + int(n >> 3 & 7)),
+                              h * (bricks[b].origin[2] + int(n & 7)));
+    return geometry::Vec3(geometry::Vec3::Zero());
   };
   if (total == 0 || samples == 0) return out;
   SegmentProximity sharp(sharp_edges(mesh, sharp_angle_deg), h);
@@ -138,7 +138,7 @@ SdfVerification verify_sdf(const WallField& field, const TriMesh& mesh, const Ex
   // which reach at most a voxel into the solid before the overlap check stops a run (the default
   // voxel is a quarter radius, the stop limit a quarter radius of overlap); deeper in the
   // three-voxel band its minima can miss a closest face the corners do not lead to.
-  auto record = [&](SdfErrors& e, double value, double reference, bool smooth, const Vec3& p,
+  auto record = [&](SdfErrors& e, double value, double reference, bool smooth, const geometry::Vec3& p,
                     double& sum, bool counted) {
     const double error = counted ? std::abs(value - reference) / h : 0.0;
     sum += error;
@@ -153,7 +153,7 @@ SdfVerification verify_sdf(const WallField& field, const TriMesh& mesh, const Ex
   // Rejection sampling: a uniform band voxel, a uniform point in the cell above it, kept when
   // all eight corners of that cell are in the band. Bounded attempts.
   for (std::size_t attempt = 0; out.samples < samples && attempt < 50 * samples; ++attempt) {
-    const Vec3 p = band_voxel(pick(rng)) + h * Vec3(offset(rng), offset(rng), offset(rng));
+    const geometry::Vec3 p = band_voxel(pick(rng)) + h * geometry::Vec3(offset(rng), offset(rng), offset(rng));
     if (!field.band_cell(p)) continue;
     const double grid_value = field.trilinear(p);
     ++out.samples;

@@ -2,9 +2,9 @@
 // `diefill sdf --verify N`: an SDF against the exact (Embree) distance of the mesh it came from.
 #include <cstdint>
 
+#include "geometry/wall_field.hpp"
 #include "mesh/exact.hpp"
 #include "mesh/sdf.hpp"
-#include "mesh/wall_field.hpp"
 
 namespace mesh {
 
@@ -12,9 +12,9 @@ struct SdfErrors {
   double max_voxels = 0;         // max |SDF - exact| over all samples, in voxels
   double mean_voxels = 0;
   double max_smooth_voxels = 0;  // over samples farther than one voxel from a sharp edge
-  Vec3 worst_smooth_point = Vec3::Zero();  // where that maximum occurs [m]
+  geometry::Vec3 worst_smooth_point = geometry::Vec3::Zero();  // where that maximum occurs [m]
   std::size_t sign_disagreements = 0;      // among samples with |exact| > 0.5 voxel
-  Vec3 first_sign_disagreement = Vec3::Zero();  // where the first one lies [m]
+  geometry::Vec3 first_sign_disagreement = geometry::Vec3::Zero();  // where the first one lies [m]
 };
 
 struct SdfVerification {
@@ -32,12 +32,12 @@ struct SdfVerification {
   std::size_t sharp_samples = 0;
   std::size_t sharp_sign_disagreements = 0;
   std::size_t sharp_contact_sign_disagreements = 0;
-  Vec3 first_sharp_disagreement = Vec3::Zero();
+  geometry::Vec3 first_sharp_disagreement = geometry::Vec3::Zero();
 };
 
 // `samples` uniformly random points in the band, reproducible from `seed`; sharp edges are
 // those whose faces meet at more than `sharp_angle_deg`.
-SdfVerification verify_sdf(const WallField& field, const TriMesh& mesh, const ExactSurface& exact,
+SdfVerification verify_sdf(const geometry::WallField& field, const geometry::TriMesh& mesh, const ExactSurface& exact,
                            std::size_t samples, std::uint64_t seed, double sharp_angle_deg = 30.0);
 
 }  // namespace mesh

@@ -8,5 +8,4 @@ std::string assimp_version();
 std::string cgal_version();
 std::string openvdb_version();
 std::string embree_version();
-std::string eigen_version();
 }  // namespace mesh

@@ -20,12 +20,12 @@ struct CellHash {
 
 }  // namespace
 
-WeldedMesh weld_close_vertices(const TriMesh& mesh, double distance) {
+WeldedMesh weld_close_vertices(const geometry::TriMesh& mesh, double distance) {
   WeldedMesh out;
   out.mesh.vertices = mesh.vertices;
   const std::size_t n = mesh.vertices.size();
   // Cells of the weld distance: the vertices closer than it lie in the 27 cells around.
-  const auto cell_of = [distance](const Vec3& p) {
+  const auto cell_of = [distance](const geometry::Vec3& p) {
     return Cell{std::llround(std::floor(p.x() / distance)), std::llround(std::floor(p.y() / distance)),
                 std::llround(std::floor(p.z() / distance))};
   };
@@ -37,7 +37,7 @@ WeldedMesh weld_close_vertices(const TriMesh& mesh, double distance) {
   for (std::size_t v = 0; v < n; ++v) {
     if (welded_to[v] >= 0) continue;
     welded_to[v] = int(v);
-    const Vec3& p = mesh.vertices[v];
+    const geometry::Vec3& p = mesh.vertices[v];
     const Cell c = cell_of(p);
     for (long long dx = -1; dx <= 1; ++dx)
       for (long long dy = -1; dy <= 1; ++dy)
@@ -54,7 +54,7 @@ WeldedMesh weld_close_vertices(const TriMesh& mesh, double distance) {
           }
         }
   }
-  for (Triangle t : mesh.triangles) {
+  for (geometry::Triangle t : mesh.triangles) {
     for (int& corner : t) corner = welded_to[std::size_t(corner)];
     if (t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) out.mesh.triangles.push_back(t);
   }

@@ -4,12 +4,12 @@
 // vertices closer than that distance become one (docs/MESHES.md, "Mesh repair").
 #include <cstddef>
 
-#include "mesh/trimesh.hpp"
+#include "geometry/trimesh.hpp"
 
 namespace mesh {
 
 struct WeldedMesh {
-  TriMesh mesh;            // the same vertex list with the welded vertices unused; triangles
+  geometry::TriMesh mesh;  // the same vertex list with the welded vertices unused; triangles
                            // left with a repeated corner dropped
   std::size_t merged = 0;  // vertices moved onto another
   double moved_m = 0.0;    // the largest distance a vertex moved [m]: at most the weld distance
@@ -18,6 +18,6 @@ struct WeldedMesh {
 // Each vertex, in index order, that no earlier vertex took takes every later one closer than
 // `distance` [m]: a welded vertex moves at most `distance` (no chains) and the result does not
 // depend on the thread count or anything but the vertex order.
-WeldedMesh weld_close_vertices(const TriMesh& mesh, double distance);
+WeldedMesh weld_close_vertices(const geometry::TriMesh& mesh, double distance);
 
 }  // namespace mesh

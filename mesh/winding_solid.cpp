@@ -23,10 +23,10 @@
 #include <unordered_map>
 
 #include "core/log.hpp"
+#include "geometry/winding.hpp"
 #include "mesh/cgal_ops.hpp"
 #include "mesh/exact.hpp"
 #include "mesh/openvdb_adapter.hpp"
-#include "mesh/winding.hpp"
 
 namespace mesh::detail {
 
@@ -44,9 +44,9 @@ constexpr double flat_adaptivity = 0.05;
 
 bool ambiguous(double w) { return w > 0.25 && w < 0.75; }
 
-TriMesh to_trimesh(const std::vector<openvdb::Vec3s>& points, const std::vector<openvdb::Vec3I>& triangles,
-                   const std::vector<openvdb::Vec4I>& quads) {
-  TriMesh out;
+geometry::TriMesh to_trimesh(const std::vector<openvdb::Vec3s>& points, const std::vector<openvdb::Vec3I>& triangles,
+                             const std::vector<openvdb::Vec4I>& quads) {
+  geometry::TriMesh out;
   out.vertices.reserve(points.size());
   for (const openvdb::Vec3s& p : points) out.vertices.emplace_back(p.x(), p.y(), p.z());
   for (const openvdb::Vec3I& t : triangles) out.triangles.push_back({int(t[0]), int(t[1]), int(t[2])});
@@ -56,14 +56,14 @@ TriMesh to_trimesh(const std::vector<openvdb::Vec3s>& points, const std::vector<
   }
   // OpenVDB winds its polygons for a level set negative inside; the mesh module's are
   // counter-clockwise from outside.
-  if (signed_volume(out) < 0)
-    for (Triangle& t : out.triangles) std::swap(t[1], t[2]);
+  if (geometry::signed_volume(out) < 0)
+    for (geometry::Triangle& t : out.triangles) std::swap(t[1], t[2]);
   return out;
 }
 
 // Terms the winding number would sum to sign every active voxel of `grid`: the mean over about
 // 2000 voxels spread evenly over the band, times its voxel count.
-double signing_terms(const openvdb::FloatGrid& grid, const WindingNumber& winding) {
+double signing_terms(const openvdb::FloatGrid& grid, const geometry::WindingNumber& winding) {
   const openvdb::Index64 voxels = grid.activeVoxelCount();
   const openvdb::Index64 stride = std::max<openvdb::Index64>(1, voxels / 2000);
   std::size_t terms = 0, samples = 0;
@@ -71,7 +71,7 @@ double signing_terms(const openvdb::FloatGrid& grid, const WindingNumber& windin
   for (auto voxel = grid.cbeginValueOn(); voxel; ++voxel, ++index)
     if (index % stride == 0) {
       const openvdb::Vec3d p = grid.transform().indexToWorld(voxel.getCoord());
-      terms += winding.terms(Vec3(p.x(), p.y(), p.z()));
+      terms += winding.terms(geometry::Vec3(p.x(), p.y(), p.z()));
       ++samples;
     }
   return samples == 0 ? 0.0 : double(terms) / double(samples) * double(voxels);
@@ -79,7 +79,7 @@ double signing_terms(const openvdb::FloatGrid& grid, const WindingNumber& windin
 
 // The soup's unsigned distance within `band` cells, negated where the winding number is ≥ ½;
 // nothing where signing it would sum more than `max_terms` terms, whose estimate `terms` holds.
-openvdb::FloatGrid::Ptr signed_band(const TriMesh& soup, const WindingNumber& winding, double cell_m, float band,
+openvdb::FloatGrid::Ptr signed_band(const geometry::TriMesh& soup, const geometry::WindingNumber& winding, double cell_m, float band,
                                     double max_terms, double& terms) {
   // The samples are offset from the axes' origin by 1/π of a cell: CAD faces lie on round
   // coordinates, and samples exactly on a face (distance 0, neither side) left OpenVDB's zero
@@ -87,7 +87,7 @@ openvdb::FloatGrid::Ptr signed_band(const TriMesh& soup, const WindingNumber& wi
   // had 17 shells, 6,685 degenerate faces and 12,440 crossing triangle pairs; shifted, its zero
   // surface crosses nowhere and the solid is one shell.
   auto transform = openvdb::math::Transform::createLinearTransform(cell_m);
-  const Vec3 origin = Vec3::Constant(0.318309886 * cell_m);
+  const geometry::Vec3 origin = geometry::Vec3::Constant(0.318309886 * cell_m);
   transform->postTranslate(openvdb::Vec3d(origin.x(), origin.y(), origin.z()));
   const TriMeshAdapter adapter{soup, 1.0 / cell_m, origin};
   openvdb::FloatGrid::Ptr grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
@@ -99,7 +99,7 @@ openvdb::FloatGrid::Ptr signed_band(const TriMesh& soup, const WindingNumber& wi
     for (auto leaf = range.begin(); leaf; ++leaf)
       for (auto voxel = leaf->beginValueOn(); voxel; ++voxel) {
         const openvdb::Vec3d p = transform->indexToWorld(voxel.getCoord());
-        if (winding(Vec3(p.x(), p.y(), p.z())) >= 0.5) voxel.setValue(-voxel.getValue());
+        if (winding(geometry::Vec3(p.x(), p.y(), p.z())) >= 0.5) voxel.setValue(-voxel.getValue());
       }
   });
   // Beyond the band the sign follows the band's: inside stays inside.
@@ -109,7 +109,7 @@ openvdb::FloatGrid::Ptr signed_band(const TriMesh& soup, const WindingNumber& wi
 
 // The zero surface of a signed band; `adaptivity` (OpenVDB's, 0 to 1) merges the cells of flat
 // regions, except where `fine` (if given) has active voxels.
-TriMesh zero_surface(const openvdb::FloatGrid& grid, double adaptivity, const openvdb::BoolTree::Ptr& fine = nullptr) {
+geometry::TriMesh zero_surface(const openvdb::FloatGrid& grid, double adaptivity, const openvdb::BoolTree::Ptr& fine = nullptr) {
   openvdb::tools::VolumeToMesh mesher(0.0, adaptivity);
   if (fine) mesher.setAdaptivityMask(fine);
   mesher(grid);
@@ -125,18 +125,18 @@ TriMesh zero_surface(const openvdb::FloatGrid& grid, double adaptivity, const op
 }
 
 // Marks the voxels within `reach` of each point, where merged cells must not reach.
-void mark_fine(openvdb::BoolTree& fine, const std::vector<Vec3>& points, const openvdb::math::Transform& transform) {
+void mark_fine(openvdb::BoolTree& fine, const std::vector<geometry::Vec3>& points, const openvdb::math::Transform& transform) {
   constexpr int reach = 2;  // [voxels]
-  for (const Vec3& p : points) {
+  for (const geometry::Vec3& p : points) {
     const openvdb::Coord c = transform.worldToIndexCellCentered(openvdb::Vec3d(p.x(), p.y(), p.z()));
     fine.fill(openvdb::CoordBBox(c.offsetBy(-reach), c.offsetBy(reach)), true, true);
   }
 }
 
-bool has_boundary(const TriMesh& mesh) {
+bool has_boundary(const geometry::TriMesh& mesh) {
   std::unordered_map<std::uint64_t, int> uses;
   uses.reserve(3 * mesh.triangles.size());
-  for (const Triangle& t : mesh.triangles)
+  for (const geometry::Triangle& t : mesh.triangles)
     for (int k = 0; k < 3; ++k) {
       const std::uint64_t a = std::uint32_t(t[k]), b = std::uint32_t(t[(k + 1) % 3]);
       ++uses[a < b ? (a << 32) | b : (b << 32) | a];
@@ -150,15 +150,15 @@ bool has_boundary(const TriMesh& mesh) {
 // pairs, none before the move). The corners of every such triangle go back where the zero
 // surface had them, until none is left or only the zero surface's own are: returns the corners
 // of those (OpenVDB's merged cells crossed in 3 pairs on the sprocket of the shared dies).
-std::vector<Vec3> put_back_folds(TriMesh& mesh, const std::vector<Vec3>& unmoved) {
+std::vector<geometry::Vec3> put_back_folds(geometry::TriMesh& mesh, const std::vector<geometry::Vec3>& unmoved) {
   for (;;) {
     const std::vector<bool> faulty = faulty_triangles(mesh);
     std::size_t put_back = 0;
-    std::vector<Vec3> unmoved_faulty;
+    std::vector<geometry::Vec3> unmoved_faulty;
     for (std::size_t f = 0; f < faulty.size(); ++f) {
       if (!faulty[f]) continue;
       for (const int corner : mesh.triangles[f]) {
-        Vec3& p = mesh.vertices[std::size_t(corner)];
+        geometry::Vec3& p = mesh.vertices[std::size_t(corner)];
         if (p == unmoved[std::size_t(corner)]) unmoved_faulty.push_back(p);
         else p = unmoved[std::size_t(corner)], ++put_back;
       }
@@ -172,22 +172,22 @@ std::vector<Vec3> put_back_folds(TriMesh& mesh, const std::vector<Vec3>& unmoved
 // along one of 13 directions (the axes, the faces' and the cube's diagonals: one within 28° of
 // any), has both ends in the solid. Each half of the segment is at most half of `offset`, so
 // that the face the point stands off and a wall meeting it in a corner are never its two ends.
-bool in_contact_sliver(const Vec3& outside, double offset, const WindingNumber& winding, const ExactSurface& surface) {
+bool in_contact_sliver(const geometry::Vec3& outside, double offset, const geometry::WindingNumber& winding, const ExactSurface& surface) {
   const double reach = std::min(0.5 * contact_gap_m, 0.5 * offset);
   if (surface.distance(outside) > reach) return false;
-  static const std::array<Vec3, 13> lines = [] {
-    std::array<Vec3, 13> d;
+  static const std::array<geometry::Vec3, 13> lines = [] {
+    std::array<geometry::Vec3, 13> d;
     int n = 0;
     for (int x = -1; x <= 1; ++x)
       for (int y = -1; y <= 1; ++y)
         for (int z = -1; z <= 1; ++z) {
-          const Vec3 v(x, y, z);
+          const geometry::Vec3 v(x, y, z);
           // one of each pair ±v: the first nonzero coordinate positive
           if ((x > 0) || (x == 0 && y > 0) || (x == 0 && y == 0 && z > 0)) d[std::size_t(n++)] = v.normalized();
         }
     return d;
   }();
-  return std::any_of(lines.begin(), lines.end(), [&](const Vec3& d) {
+  return std::any_of(lines.begin(), lines.end(), [&](const geometry::Vec3& d) {
     return winding(outside + reach * d) >= 0.5 && winding(outside - reach * d) >= 0.5;
   });
 }
@@ -196,18 +196,18 @@ bool in_contact_sliver(const Vec3& outside, double offset, const WindingNumber& 
 // faces of closed gaps or of parts in contact, and the farthest of them inside the result.
 struct CoveredFaces {
   std::mutex mutex;
-  std::vector<Vec3> points;
+  std::vector<geometry::Vec3> points;
 
-  void add(const Vec3& p) {
+  void add(const geometry::Vec3& p) {
     const std::lock_guard<std::mutex> lock(mutex);
     points.push_back(p);
   }
   // The farthest point from `result`'s surface and its distance, over points in a fixed order.
-  std::pair<double, Vec3> farthest(const ExactSurface* result) {
+  std::pair<double, geometry::Vec3> farthest(const ExactSurface* result) {
     std::sort(points.begin(), points.end(),
-              [](const Vec3& a, const Vec3& b) { return std::tie(a.x(), a.y(), a.z()) < std::tie(b.x(), b.y(), b.z()); });
-    std::pair<double, Vec3> out{0.0, Vec3::Zero()};
-    for (const Vec3& p : points) {
+              [](const geometry::Vec3& a, const geometry::Vec3& b) { return std::tie(a.x(), a.y(), a.z()) < std::tie(b.x(), b.y(), b.z()); });
+    std::pair<double, geometry::Vec3> out{0.0, geometry::Vec3::Zero()};
+    for (const geometry::Vec3& p : points) {
       const double depth = result->distance(p);
       if (depth > out.first) out = {depth, p};
     }
@@ -218,16 +218,16 @@ struct CoveredFaces {
 // A grain of radius `radius_m` against the input: whether it can touch a point of its bounding
 // surface from the free space, which lies inside the solid or outside it.
 struct GrainProbe {
-  const WindingNumber& winding;
+  const geometry::WindingNumber& winding;
   const ExactSurface& surface;
   double radius_m;
 
   // `p` lies on a face of unit `normal`, with the solid on that side or not.
-  bool touches(const Vec3& p, const Vec3& normal, bool solid_ahead, bool free_space_inside) const {
-    const auto free_at = [&](const Vec3& x) { return (winding(x) >= 0.5) == free_space_inside; };
-    const Vec3 centre = p + (solid_ahead == free_space_inside ? radius_m : -radius_m) * normal;
+  bool touches(const geometry::Vec3& p, const geometry::Vec3& normal, bool solid_ahead, bool free_space_inside) const {
+    const auto free_at = [&](const geometry::Vec3& x) { return (winding(x) >= 0.5) == free_space_inside; };
+    const geometry::Vec3 centre = p + (solid_ahead == free_space_inside ? radius_m : -radius_m) * normal;
     if (!free_at(centre)) return false;
-    const Vec3 nearest = surface.closest_point(centre);
+    const geometry::Vec3 nearest = surface.closest_point(centre);
     const double clearance = (nearest - centre).norm();
     if (clearance >= 0.999 * radius_m) return true;  // the grain fits
     // What it overlaps must bound the free space, not lie in the open: just beyond it (a
@@ -240,8 +240,8 @@ struct GrainProbe {
 // `zero` with its vertices moved onto the closest input point, and how far that leaves the
 // input's bounding surface from it, not counting the faces of `gaps` it closed; `beyond` (if
 // given) receives the input's sample points left farther than a cell from it.
-WindingSolid on_input(TriMesh zero, const TriMesh& soup, const ExactSurface& surface, const WindingNumber& winding,
-                      double cell_m, const ClosableGaps& gaps, std::vector<Vec3>* beyond = nullptr) {
+WindingSolid on_input(geometry::TriMesh zero, const geometry::TriMesh& soup, const ExactSurface& surface, const geometry::WindingNumber& winding,
+                      double cell_m, const ClosableGaps& gaps, std::vector<geometry::Vec3>* beyond = nullptr) {
   // The zero surface cuts corners by up to a cell; its vertices moved onto the closest input
   // point lie on the surface the file means, sharp edges and flat faces included (a flat top
   // face stays exactly flat, which the die's opening needs).
@@ -249,11 +249,11 @@ WindingSolid on_input(TriMesh zero, const TriMesh& soup, const ExactSurface& sur
   // the gap within a cell of where the face was, not on it; at the part's extremes that face was
   // flat (the flanged ring of the shared dies lacks its flange face, the side the die opens on),
   // so such vertices within a cell of the input's bounding box go onto the box's face.
-  const Box box = bounding_box(soup);
-  const std::vector<Vec3> unmoved = zero.vertices;
+  const geometry::Box box = geometry::bounding_box(soup);
+  const std::vector<geometry::Vec3> unmoved = zero.vertices;
   tbb::parallel_for(std::size_t(0), zero.vertices.size(), [&](std::size_t v) {
-    Vec3& p = zero.vertices[v];
-    const Vec3 closest = surface.closest_point(p);
+    geometry::Vec3& p = zero.vertices[v];
+    const geometry::Vec3 closest = surface.closest_point(p);
     if ((closest - p).norm() <= cell_m) {
       p = closest;
       return;
@@ -280,7 +280,7 @@ WindingSolid on_input(TriMesh zero, const TriMesh& soup, const ExactSurface& sur
   CoveredFaces gap_faces, contact_faces;
   FarthestSample moved = farthest_sample(
       soup, zero,
-      [&](const Vec3& p, const Vec3& normal) {
+      [&](const geometry::Vec3& p, const geometry::Vec3& normal) {
         const bool solid_ahead = winding(p + offset * normal) >= 0.5;
         if (solid_ahead == (winding(p - offset * normal) >= 0.5)) return false;
         if (in_contact_sliver(p + (solid_ahead ? -offset : offset) * normal, offset, winding, surface)) {
@@ -309,7 +309,7 @@ WindingSolid on_input(TriMesh zero, const TriMesh& soup, const ExactSurface& sur
 
 struct SurveyTally {
   long solid = 0, unclear = 0;
-  Box unclear_box;
+  geometry::Box unclear_box;
   void add(const SurveyTally& other) {
     solid += other.solid;
     unclear += other.unclear;
@@ -330,7 +330,7 @@ struct SurveyTally {
 // were two thirds of a small die's repair under the sanitizers).
 class Survey {
  public:
-  Survey(const TriMesh& soup, const Box& box, double cell_m, const Eigen::Vector3i& cells)
+  Survey(const geometry::TriMesh& soup, const geometry::Box& box, double cell_m, const Eigen::Vector3i& cells)
       : winding_(soup), surface_(soup), box_(box), cell_m_(cell_m), cells_(cells) {}
 
   SurveyTally block(const Eigen::Vector3i& first, int size) const {
@@ -341,11 +341,11 @@ class Survey {
         for (int j = first.y(); j < end.y(); ++j)
           for (int i = first.x(); i < end.x(); ++i) {
             const Eigen::Vector3i cell(i, j, k);
-            add_cells(winding_(corner(cell) + Vec3::Constant(0.5 * cell_m_)), cell, cell + Eigen::Vector3i::Ones(), tally);
+            add_cells(winding_(corner(cell) + geometry::Vec3::Constant(0.5 * cell_m_)), cell, cell + Eigen::Vector3i::Ones(), tally);
           }
       return tally;
     }
-    const Vec3 lo = corner(first), hi = corner(end), centre = 0.5 * (lo + hi);
+    const geometry::Vec3 lo = corner(first), hi = corner(end), centre = 0.5 * (lo + hi);
     if (surface_.distance(centre) > 0.5 * (hi - lo).norm()) {
       if (const std::optional<double> w = clear_value(lo, hi, centre)) {
         add_cells(*w, first, end, tally);
@@ -363,17 +363,17 @@ class Survey {
  private:
   static constexpr double clear_margin = 0.15;
 
-  Vec3 corner(const Eigen::Vector3i& cell) const { return box_.lo + cell_m_ * cell.cast<double>(); }
+  geometry::Vec3 corner(const Eigen::Vector3i& cell) const { return box_.lo + cell_m_ * cell.cast<double>(); }
 
   // The winding number at the block's centre where it and the eight corners' are all at most
   // `clear_margin` or all at least 1 - `clear_margin`; nothing otherwise.
-  std::optional<double> clear_value(const Vec3& lo, const Vec3& hi, const Vec3& centre) const {
+  std::optional<double> clear_value(const geometry::Vec3& lo, const geometry::Vec3& hi, const geometry::Vec3& centre) const {
     const double w = winding_(centre);
     const bool solid = w >= 0.5;
     const auto clear = [&](double x) { return solid ? x >= 1.0 - clear_margin : x <= clear_margin; };
     if (!clear(w)) return std::nullopt;
     for (int k = 0; k < 8; ++k) {
-      const Vec3 p((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z());
+      const geometry::Vec3 p((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z());
       if (!clear(winding_(p))) return std::nullopt;
     }
     return w;
@@ -389,9 +389,9 @@ class Survey {
     }
   }
 
-  WindingNumber winding_;
+  geometry::WindingNumber winding_;
   ExactSurface surface_;
-  Box box_;
+  geometry::Box box_;
   double cell_m_;
   Eigen::Vector3i cells_;
 };
@@ -406,16 +406,16 @@ constexpr int survey_block_cells = 16;
 // each other. Nothing where the merged surface is empty, open, or still moved beyond a cell or
 // crossing once fine cells stop helping (the planetary gear set as a cavity: die walls between
 // its gears thinner than a cell, which no cell size here keeps).
-std::optional<WindingSolid> merged_where_flat(const openvdb::FloatGrid& grid, const TriMesh& soup,
-                                              const ExactSurface& surface, const WindingNumber& winding, double cell_m,
+std::optional<WindingSolid> merged_where_flat(const openvdb::FloatGrid& grid, const geometry::TriMesh& soup,
+                                              const ExactSurface& surface, const geometry::WindingNumber& winding, double cell_m,
                                               const ClosableGaps& gaps) {
   constexpr int most_rounds = 3;
   const auto fine = std::make_shared<openvdb::BoolTree>(false);
-  std::vector<Vec3> beyond;
+  std::vector<geometry::Vec3> beyond;
   double moved_before = std::numeric_limits<double>::infinity();
   std::size_t folded_before = std::numeric_limits<std::size_t>::max();
   for (int round = 0; round <= most_rounds; ++round) {
-    TriMesh zero = zero_surface(grid, flat_adaptivity, round == 0 ? nullptr : fine);
+    geometry::TriMesh zero = zero_surface(grid, flat_adaptivity, round == 0 ? nullptr : fine);
     if (zero.triangles.empty() || has_boundary(zero)) return std::nullopt;
     WindingSolid solid = on_input(std::move(zero), soup, surface, winding, cell_m, gaps, &beyond);
     diefill::log::debug("repair: winding-number solid, merged where flat (round {}): {} triangles, moved {:.4g} mm at "
@@ -434,8 +434,8 @@ std::optional<WindingSolid> merged_where_flat(const openvdb::FloatGrid& grid, co
 
 }  // namespace
 
-WindingSurvey survey_winding(const TriMesh& soup, int cells) {
-  const Box box = bounding_box(soup);
+WindingSurvey survey_winding(const geometry::TriMesh& soup, int cells) {
+  const geometry::Box box = geometry::bounding_box(soup);
   const double h = box.size().maxCoeff() / cells;
   const Eigen::Vector3i n = (box.size() / h).array().ceil().cast<int>().max(1);
   const Survey survey(soup, box, h, n);
@@ -466,9 +466,9 @@ double winding_solid_cells(double surface_area_m2, double cell_m) {
   return 2.0 * double(band_cells) * surface_area_m2 / (cell_m * cell_m);
 }
 
-WindingSolid winding_solid(const TriMesh& soup, double cell_m, const ClosableGaps& gaps, double max_terms) {
+WindingSolid winding_solid(const geometry::TriMesh& soup, double cell_m, const ClosableGaps& gaps, double max_terms) {
   initialise_openvdb();
-  const WindingNumber winding(soup);
+  const geometry::WindingNumber winding(soup);
   const ExactSurface surface(soup);
   double spent = 0.0;
   for (float band = band_cells; band <= widest_band_cells; band *= 2) {
@@ -482,7 +482,7 @@ WindingSolid winding_solid(const TriMesh& soup, double cell_m, const ClosableGap
     spent += terms;
     if (std::optional<WindingSolid> solid = merged_where_flat(*grid, soup, surface, winding, cell_m, gaps)) return *solid;
     // Every cell fine.
-    TriMesh zero = zero_surface(*grid, 0.0);
+    geometry::TriMesh zero = zero_surface(*grid, 0.0);
     if (zero.triangles.empty()) return {};  // nothing has winding number ≥ ½
     if (!has_boundary(zero)) return on_input(std::move(zero), soup, surface, winding, cell_m, gaps);
   }

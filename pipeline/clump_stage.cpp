@@ -6,7 +6,7 @@
 
 namespace pipeline {
 
-mesh::ClumpTemplate build_clump(const ClumpRequest& request) {
+geometry::ClumpTemplate build_clump(const ClumpRequest& request) {
   const mesh::ImportResult imported = mesh::import_mesh(request.mesh, {request.unit});
   const mesh::RepairResult repaired =
       mesh::repair(imported.mesh, mesh::grain_repair_options(imported.mesh, request.tolerance), request.mesh.string());

@@ -5,20 +5,20 @@
 #include <cstdint>
 #include <filesystem>
 
+#include "geometry/trimesh.hpp"
 #include "mesh/clump.hpp"
-#include "mesh/trimesh.hpp"
 
 namespace pipeline {
 
 struct ClumpRequest {
   std::filesystem::path mesh;
-  mesh::LengthUnit unit = mesh::LengthUnit::mm;
+  geometry::LengthUnit unit = geometry::LengthUnit::mm;
   double tolerance = 0.05;
   int max_spheres = 64;
   std::uint64_t seed = 1;
 };
 
 // Throws InputError for a mesh that cannot be repaired or a tolerance the spheres cannot meet.
-mesh::ClumpTemplate build_clump(const ClumpRequest& request);
+geometry::ClumpTemplate build_clump(const ClumpRequest& request);
 
 }  // namespace pipeline

@@ -25,7 +25,7 @@ struct CavityBox {
 CavityBox cavity_box(const mesh::PreparedDie& die) {
   CavityBox c;
   c.container = die.sdf.metadata().count("role") && die.sdf.metadata().at("role") == "container";
-  const mesh::Box box = die.after.bbox;
+  const geometry::Box box = die.after.bbox;
   c.lo = box.lo;
   c.hi = post::Vec3(box.hi.x(), box.hi.y(), c.container ? box.hi.z() : die.table_z);
   c.centre = post::Vec3(0.5 * (c.lo.x() + c.hi.x()), 0.5 * (c.lo.y() + c.hi.y()), c.hi.z());
@@ -35,8 +35,8 @@ CavityBox cavity_box(const mesh::PreparedDie& die) {
 // The grains binned on voxels of edge `voxel` and corrected for the walls: exactly, or by the
 // Gaussian kernel of `width` over the identically smoothed cavity (the kernel method).
 post::DensityField binned_field(const std::vector<post::Grain>& grains, const CavityBox& c,
-                                const mesh::WallField& walls, double voxel,
-                                scene::DensityMethod method, double width, const DensitySettings& s) {
+                                const geometry::WallField& walls, double voxel,
+                                scene::DensityMethod method, double width, const DensityOptions& s) {
   post::DensityField f;
   const post::Vec3 reach = post::Vec3::Constant(method == scene::DensityMethod::gaussian ? 3 * width : 0.0);  // every kernel whole
   f.grid = post::grid_covering(c.lo - reach, c.hi + reach, voxel,
@@ -57,14 +57,14 @@ post::DensityField binned_field(const std::vector<post::Grain>& grains, const Ca
     f.corrected = post::correct_for_walls(f.grid, f.solid, smoothed_cavity, s.min_cavity);
     f.metadata["width_m"] = fmt::format("{:.9g}", width);
   }
-  f.metadata["method"] = std::string(scene::choice_name(scene::density_methods, method));
+  f.metadata["method"] = std::string(diefill::choice_name(scene::density_methods, method));
   return f;
 }
 
-post::Outlines outlines_of(const mesh::TriMesh& cavity, const CavityBox& c, double voxel) {
+post::Outlines outlines_of(const geometry::TriMesh& cavity, const CavityBox& c, double voxel) {
   const double below_opening = c.hi.z() - 0.25 * std::min(voxel, c.hi.z() - c.lo.z());
-  return {mesh::plane_section(cavity, 2, below_opening), mesh::plane_section(cavity, 1, c.centre.y()),
-          mesh::plane_section(cavity, 0, c.centre.x())};
+  return {geometry::plane_section(cavity, 2, below_opening), geometry::plane_section(cavity, 1, c.centre.y()),
+          geometry::plane_section(cavity, 0, c.centre.x())};
 }
 
 }  // namespace
@@ -90,7 +90,7 @@ std::vector<post::Region> fill_regions(const post::VoxelGrid& g, const post::Vec
 }
 
 DensityResult compute_density(const std::vector<post::Grain>& grains, const mesh::PreparedDie& die,
-                              const mesh::WallField& walls, double material_density, const DensitySettings& s,
+                              const geometry::WallField& walls, double material_density, const DensityOptions& s,
                               const std::string& particles_source) {
   if (!(s.voxel_m > 0)) throw diefill::InputError("density", "voxel", "must be positive", "Give the voxel edge");
   const CavityBox c = cavity_box(die);

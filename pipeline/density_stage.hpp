@@ -15,7 +15,7 @@
 
 namespace pipeline {
 
-struct DensitySettings {
+struct DensityOptions {
   double voxel_m = 1e-3;           // density voxel edge
   scene::DensityMethod method = scene::DensityMethod::exact;
   double width_m = 0;              // Gaussian width (default: one voxel)
@@ -45,7 +45,7 @@ std::vector<post::Region> fill_regions(const post::VoxelGrid& grid, const post::
 
 // Throws InputError when no grain lies in the die's cavity (the wrong die, or wrong units).
 DensityResult compute_density(const std::vector<post::Grain>& grains, const mesh::PreparedDie& die,
-                              const mesh::WallField& walls, double material_density, const DensitySettings& settings,
+                              const geometry::WallField& walls, double material_density, const DensityOptions& settings,
                               const std::string& particles_source);
 
 // A seed ensemble's field (pipeline/ensemble.hpp): its seeds' fields, on one grid and one cavity

@@ -48,8 +48,8 @@ nlohmann::json compaction_example(const post::FemFill& fill, const fs::path& dir
 
 }  // namespace
 
-FemSettings fem_settings(double grain_diameter, double density_voxel, double element_size) {
-  FemSettings s;
+FemOptions fem_options(double grain_diameter, double density_voxel, double element_size) {
+  FemOptions s;
   s.element_size_m = element_size > 0 ? element_size : density_voxel;
   // A quarter grain diameter: at half one, the elements along the walls read 0.02 above the
   // grains' own solid there (ring, 1.6 mm grains, tests/fem_wall_layer.py), at a quarter 0.007.
@@ -62,7 +62,7 @@ namespace {
 // One realisation's fill, or a seed ensemble's: the mean of its realisations' element values on
 // the one mesh (Mesh_3 is deterministic, and each is filled on a copy of it), with their
 // standard errors.
-post::FemFill fill_of_realisations(const mesh::TetMesh& tets, const std::vector<std::vector<post::Grain>>& realisations,
+post::FemFill fill_of_realisations(const geometry::TetMesh& tets, const std::vector<std::vector<post::Grain>>& realisations,
                                    const post::CavityShape& cavity, double sub_voxel, double material_density) {
   std::vector<post::FemFill> fills;
   for (const std::vector<post::Grain>& grains : realisations)
@@ -83,8 +83,8 @@ post::FemFill fill_of_realisations(const mesh::TetMesh& tets, const std::vector<
 }  // namespace
 
 nlohmann::json write_fem_outputs(const std::vector<std::vector<post::Grain>>& realisations, const mesh::PreparedDie& die,
-                                 const mesh::WallField& walls, double material_density, double mass_in_cavity_kg,
-                                 const FemSettings& s, const fs::path& dir) {
+                                 const geometry::WallField& walls, double material_density, double mass_in_cavity_kg,
+                                 const FemOptions& s, const fs::path& dir) {
   diefill::ChildWait wait;
   wait.stop = stop_requested;
   wait.waiting = [&](double seconds) {
@@ -92,8 +92,8 @@ nlohmann::json write_fem_outputs(const std::vector<std::vector<post::Grain>>& re
                        "the hand-off and keeps the fill; fem.element_size coarsens it)",
                        die.name, s.element_size_m * 1e3, seconds);
   };
-  const mesh::TetMesh tets = mesh::tetrahedralise(die.cavity, {s.element_size_m, s.element_size_m / 200, 60}, die.source, wait);
-  const mesh::TetQuality q = mesh::tet_quality(tets);
+  const geometry::TetMesh tets = mesh::tetrahedralise(die.cavity, {s.element_size_m, s.element_size_m / 200, 60}, die.source, wait);
+  const geometry::TetQuality q = geometry::tet_quality(tets);
   const post::CavityShape cavity{[&](const post::Vec3& p) { return walls.signed_distance(p); }, die.after.bbox.lo,
                                  post::Vec3(die.after.bbox.hi.x(), die.after.bbox.hi.y(), die.table_z)};
   const post::FemFill fill = fill_of_realisations(tets, realisations, cavity, s.sub_voxel_m, material_density);

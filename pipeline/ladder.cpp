@@ -82,7 +82,7 @@ void check_levels(const std::function<scene::PipelineScene(const std::vector<std
   const scene::PipelineScene coarsest = level_scene(load, ladder.alphas.front(), finest, {});
   const DieSource die = read_die(coarsest.die, coarsest.die.file);
   const double d = coarsest.powder.grain_diameter();
-  const mesh::Box box = mesh::bounding_box(die.file.mesh);
+  const geometry::Box box = geometry::bounding_box(die.file.mesh);
   const double spacing = std::max(std::min(box.size().minCoeff() / 8, grains_across_needed * d / 8), std::cbrt(box.size().prod() / 5e5));
   const Refusal r = refuse_thin_features(mesh::feature_widths(die.file.mesh, die.table_z, spacing), d, coarsest.powder.particle_diameter);
   if (!r.reason.empty())

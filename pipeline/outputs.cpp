@@ -25,8 +25,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-DensitySettings density_settings(const scene::DensitySettings& density, const GrainSizing& grains) {
-  DensitySettings ds;
+DensityOptions density_options(const scene::DensitySettings& density, const GrainSizing& grains) {
+  DensityOptions ds;
   ds.voxel_m = density.voxel > 0 ? density.voxel : 2 * grains.diameter;
   ds.method = density.method;
   ds.smoothed_width_m = density.smoothed_width > 0 ? density.smoothed_width : 0.5 * grains.diameter;
@@ -44,7 +44,7 @@ nlohmann::json write_density_field(const FillSetting& c, const Realisations& r, 
     diefill::log::warn("{}: no grain entered the cavity; no density field", c.walls.die.name);
     return {{"mass_kg", 0.0}, {"fill_ratio", 0.0}, {"voxel_m", 0.0}};
   }
-  const DensitySettings ds = density_settings(c.scene.density, c.grains);
+  const DensityOptions ds = density_options(c.scene.density, c.grains);
   std::vector<DensityResult> fields;
   std::vector<nlohmann::json> figures;
   for (const std::vector<post::Grain>& grains : r.cavity) {
@@ -61,7 +61,7 @@ nlohmann::json write_density_field(const FillSetting& c, const Realisations& r, 
 // The FEM hand-off (fem/), on elements as large as the density voxels unless the scene says.
 nlohmann::json write_fem_section(const FillSetting& c, const Realisations& r, const nlohmann::json& fill, const fs::path& dir) {
   if (fill.at("voxel_m").get<double>() <= 0 || c.scene.fem.elements == scene::FemElements::none) return nullptr;
-  FemSettings settings = fem_settings(c.grains.diameter, fill.at("voxel_m").get<double>(), c.scene.fem.element_size);
+  FemOptions settings = fem_options(c.grains.diameter, fill.at("voxel_m").get<double>(), c.scene.fem.element_size);
   settings.quadratic = c.scene.fem.elements == scene::FemElements::quadratic;
   settings.compaction = c.scene.fem.compaction == scene::FemCompaction::calculix;
   try {
@@ -78,7 +78,7 @@ nlohmann::json write_fem_section(const FillSetting& c, const Realisations& r, co
 // material) and the strike-off.
 nlohmann::json write_fill_curve_outputs(const FillSetting& c, const Realisations& r, const fs::path& dir) {
   const double capacity = c.walls.die.after.volume_m3 * powder_density(c.walls);
-  const double strike_off = strike_off_time(c.shoe, mesh::bounding_box(c.walls.die.cavity).hi.x());
+  const double strike_off = strike_off_time(c.shoe, geometry::bounding_box(c.walls.die.cavity).hi.x());
   if (r.curves.size() == 1) {
     write_fill_curve(r.curves.front(), capacity, dir / "fill_curve.csv");
   } else {
@@ -121,7 +121,7 @@ nlohmann::json report_json(const FillRecord& r, const nlohmann::json& fill, cons
        {{"name", die.name},
         {"source", die.source},
         {"sha256", die.sha256},
-        {"units", mesh::unit_name(die.unit)},
+        {"units", geometry::unit_name(die.unit)},
         {"units_guessed", die.unit_guessed},
         {"up_in_file", mesh::up_name(die.up)},
         {"up_found", die.up_found},

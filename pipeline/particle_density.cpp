@@ -16,8 +16,9 @@
 namespace pipeline {
 
 int particle_density(const ParticleDensityRequest& r) {
-  const std::optional<mesh::LengthUnit> unit = mesh::parse_unit_or_auto(r.units, "--units");
+  const std::optional<geometry::LengthUnit> unit = geometry::parse_unit_or_auto(r.units, "--units");
   const mesh::WallRole role = mesh::parse_role(r.role, "--role");
+  const scene::DensityMethod method = scene::parse_choice(scene::density_methods, r.method, "--method");
   if (role == mesh::WallRole::tool)
     throw diefill::InputError(r.die.string(), "--role", "a density field needs the cavity, not the tool body",
                               "Give the cavity mesh (role cavity) or a container");
@@ -42,10 +43,10 @@ int particle_density(const ParticleDensityRequest& r) {
   const mesh::DieFile file = mesh::read_die_file(r.die, unit, mesh::up_to_read(sized), mesh::parting_to_read(sized));
   sized.unit = file.unit;
   const mesh::PreparedDie die = mesh::prepare_die(file, sized, std::nullopt);
-  const mesh::WallField walls = die.sdf.wall_field(die.solid);
-  DensitySettings s;
+  const geometry::WallField walls = die.sdf.wall_field(die.solid);
+  DensityOptions s;
   s.voxel_m = r.voxel_m > 0 ? r.voxel_m : 4 * r_max;
-  s.method = scene::parse_choice(scene::density_methods, r.method, "--method");
+  s.method = method;
   s.width_m = r.width_m;
   s.smoothed_width_m = r.smoothed_width_m > 0 ? r.smoothed_width_m : r_max;  // as the pipeline: half a diameter
   s.coarse_graining = r.coarse_graining;
@@ -54,11 +55,11 @@ int particle_density(const ParticleDensityRequest& r) {
   write_density(result, out.path());
   nlohmann::json report = {{"die", {{"name", die.name}, {"source", die.source}, {"sha256", die.sha256}}},
                            {"particles", {{"source", r.particles.string()}, {"grains", grains.size()}}},
-                           {"density", {{"voxel_m", s.voxel_m}, {"method", std::string(scene::choice_name(scene::density_methods, s.method))}, {"smoothed_width_m", s.smoothed_width_m}, {"material_density", material_density},
+                           {"density", {{"voxel_m", s.voxel_m}, {"method", std::string(diefill::choice_name(scene::density_methods, s.method))}, {"smoothed_width_m", s.smoothed_width_m}, {"material_density", material_density},
                                         {"coarse_graining", r.coarse_graining}}},
                            {"fill", statistics_json(result.stats)}};
   if (r.fem) {
-    FemSettings fem = fem_settings(2 * r_max, s.voxel_m, r.element_size_m);
+    FemOptions fem = fem_options(2 * r_max, s.voxel_m, r.element_size_m);
     fem.quadratic = r.quadratic;
     report["fem"] = write_fem_outputs({grains}, die, walls, material_density, result.stats.mass_kg, fem, out.path());
   }

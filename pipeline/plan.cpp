@@ -42,7 +42,7 @@ DieSource read_die(const scene::DieSettings& die_settings, const std::filesystem
     diefill::log::info("{}: the file holds {} separate bodies (pieces that share no vertex), filled as one part; if they are "
                        "an assembly's parts, die.part = N takes the N-th largest alone (docs/MESHES.md, \"Assemblies\")",
                        die.file.name, die.file.bodies);
-  die.box = mesh::bounding_box(die.file.mesh);
+  die.box = geometry::bounding_box(die.file.mesh);
   if (die.file.parting_z) {
     // The height of the cut is said once, by the repair action that makes it (mesh/die.cpp), on
     // the repaired part: repair may move the part's lowest point, so a figure here could differ.

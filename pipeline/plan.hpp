@@ -13,7 +13,7 @@ namespace pipeline {
 // The die's file as read: its mesh in metres, its box and the table's height (its highest z).
 struct DieSource {
   mesh::DieFile file;
-  mesh::Box box;
+  geometry::Box box;
   double table_z = 0;
 };
 DieSource read_die(const scene::DieSettings& die, const std::filesystem::path& die_mesh);

@@ -37,10 +37,10 @@ std::vector<double> alpha_grid() {
 }
 
 // The cavity's walls, its opening left out: where the wall layer lies.
-double wall_area(const mesh::TriMesh& cavity, double table_z) {
+double wall_area(const geometry::TriMesh& cavity, double table_z) {
   double area = 0;
   for (const auto& t : cavity.triangles) {
-    const mesh::Vec3 &a = cavity.vertices[t[0]], &b = cavity.vertices[t[1]], &c = cavity.vertices[t[2]];
+    const geometry::Vec3 &a = cavity.vertices[t[0]], &b = cavity.vertices[t[1]], &c = cavity.vertices[t[2]];
     const bool opening = std::min({a.z(), b.z(), c.z()}) >= table_z - 1e-9;
     if (!opening) area += 0.5 * (b - a).cross(c - a).norm();
   }
@@ -126,7 +126,7 @@ Plan make_plan(const scene::PipelineScene& scene, const PlanRequest& request) {
   const DieSource die = read_die(scene.die, scene.die.file);
   plan.die = die.file.name;
   const ShoePlan shoe = plan_shoe(scene.shoe, scene.motion, die);
-  const mesh::Box box = mesh::bounding_box(die.file.mesh);
+  const geometry::Box box = geometry::bounding_box(die.file.mesh);
   const mesh::FeatureWidths widths =
       mesh::feature_widths(die.file.mesh, die.table_z, std::max(box.size().minCoeff() / 16, std::cbrt(box.size().prod() / 5e5)));
   plan.narrowest_feature_m = narrowest_tenth(widths);

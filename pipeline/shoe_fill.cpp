@@ -34,7 +34,7 @@ struct Insertion {
   const GrainSizing& grains;
   const ShoePlan& shoe;
   double table_z;
-  std::optional<mesh::ClumpTemplate> clump;
+  std::optional<geometry::ClumpTemplate> clump;
   std::shared_ptr<dem::Exchange> ranks;  // null: one process
 };
 
@@ -150,9 +150,9 @@ void rest(dem::State& state) {
 
 // Every rank builds the clump template itself (from the same mesh and seed) and keeps its share
 // of clumps drawn from it: should the builds ever differ, the shares would not fit together.
-void expect_same_template_on_every_rank(const mesh::ClumpTemplate& clump, dem::Exchange& ranks) {
+void expect_same_template_on_every_rank(const geometry::ClumpTemplate& clump, dem::Exchange& ranks) {
   double fingerprint = clump.mesh_volume_m3;
-  for (const mesh::ClumpSphere& sphere : clump.spheres) fingerprint += sphere.radius + sphere.centre.sum() * 0.5;
+  for (const geometry::ClumpSphere& sphere : clump.spheres) fingerprint += sphere.radius + sphere.centre.sum() * 0.5;
   if (ranks.max(fingerprint) != -ranks.max(-fingerprint))
     throw std::logic_error("the ranks built different clump templates from one grain mesh");
 }

@@ -21,8 +21,8 @@ namespace fs = std::filesystem;
 namespace {
 
 // The shoe's surface in its own frame (the pose at a time is its motion's position).
-mesh::TriMesh surface_of(const mesh::WallField& field) {
-  mesh::TriMesh m;
+geometry::TriMesh surface_of(const geometry::WallField& field) {
+  geometry::TriMesh m;
   m.vertices = field.vertices;
   m.triangles = field.triangles;
   return m;
@@ -30,7 +30,7 @@ mesh::TriMesh surface_of(const mesh::WallField& field) {
 
 // `series.pvd`: ParaView opens the snapshots as one time series, with the die (fixed) and the
 // shoe at each snapshot's pose beside the grains.
-void write_series(const mesh::TriMesh& die_solid, const std::vector<double>& times, const fs::path& dir) {
+void write_series(const geometry::TriMesh& die_solid, const std::vector<double>& times, const fs::path& dir) {
   mesh::write_vtp(die_solid, dir / "die.vtp");
   std::string pvd = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
   for (std::size_t k = 0; k < times.size(); ++k)
@@ -104,7 +104,7 @@ std::optional<FillResult> move_shoe(const scene::PipelineScene& s, const FillWal
                                        [&] { so_far = load_outputs(checkpoint, state.time, s.seed); });
   fill.curve = std::move(so_far.curve);
   std::vector<double>& snapshot_times = so_far.snapshot_times;
-  const mesh::TriMesh shoe_surface = surface_of(*walls.shoe_field);
+  const geometry::TriMesh shoe_surface = surface_of(*walls.shoe_field);
   LoopOptions loop;
   loop.until = shoe.t_motion + s.motion.die_settle_time;
   loop.max_steps = s.max_steps;

@@ -43,11 +43,11 @@ void add_mesh_walls(scene::SimulationScene& scene) {
   for (double r : scene.state.radius) r_max = std::max(r_max, r);
   for (const scene::MeshWallEntry& w : scene.mesh_walls) {
     mesh::DieOptions options = mesh::die_options_for_grains(r_max, scene.spec.skin.value_or(0.5 * r_max));
-    options.unit = mesh::parse_unit(w.units, w.name + ".units");
+    options.unit = geometry::parse_unit(w.units, w.name + ".units");
     options.role = mesh::parse_role(w.role, w.name + ".role");
     const mesh::PreparedDie die = mesh::prepare_die(w.file, options, std::nullopt);
     dem::MeshWall wall =
-        dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid)), w.material, w.name);
+        dem::fixed_mesh_wall(std::make_shared<const geometry::WallField>(die.sdf.wall_field(die.solid)), w.material, w.name);
     if (w.motion) wall.motion = *w.motion;
     scene.spec.meshes.push_back(wall);
   }

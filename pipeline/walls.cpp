@@ -38,17 +38,17 @@ mesh::DieOptions die_options(const scene::PipelineScene& s, const GrainSizing& g
 // A shoe from a mesh is a tool in its own frame (origin at the inner centre, on the table); the
 // built-in one a rectangular tube. Voxels as mesh::contact_wall_field's: the query is exact, the
 // voxels only find candidates.
-std::shared_ptr<const mesh::WallField> shoe_field(const scene::PipelineScene& s, const GrainSizing& grains, const ShoePlan& shoe,
-                                                  mesh::LengthUnit unit, const std::filesystem::path& cache) {
+std::shared_ptr<const geometry::WallField> shoe_field(const scene::PipelineScene& s, const GrainSizing& grains, const ShoePlan& shoe,
+                                                      geometry::LengthUnit unit, const std::filesystem::path& cache) {
   const double r = grains.r_max;
   if (s.shoe.mesh.empty())
-    return std::make_shared<const mesh::WallField>(
+    return std::make_shared<const geometry::WallField>(
         mesh::contact_wall_field(mesh::shoe_solid(shoe.length, shoe.width, s.shoe.height, s.shoe.wall), r));
   mesh::DieOptions o = mesh::die_options_for_grains(r, 0.5 * r, 0.5 * r);
   o.unit = unit;
   o.role = mesh::WallRole::tool;
   const mesh::PreparedDie prepared = mesh::prepare_die(s.shoe.mesh, o, cache);
-  return std::make_shared<const mesh::WallField>(prepared.sdf.wall_field(prepared.solid));
+  return std::make_shared<const geometry::WallField>(prepared.sdf.wall_field(prepared.solid));
 }
 
 // Grains too coarse for the cavity: refused when none can enter it; warned when it is narrower
@@ -69,13 +69,12 @@ void check_grains_enter(const FillWalls& w, const DieSource& source, const Grain
 }
 
 // The coarse-grained laws with the die and the shoe as walls, inside the table's extent; the
-// walls' places recorded in `w`.
+// shoe's place recorded in `w`.
 dem::ModelSpec fill_spec(const scene::PipelineScene& s, FillWalls& w, const DieSource& source, const GrainSizing& grains,
                          const ShoePlan& shoe, const mesh::TableExtent& table) {
   dem::ModelSpec spec = fill_laws(s, grains, source.box.size().z());
   spec.domain = {Vec3(table.x_min, table.y_min, source.box.lo.z() - 1e-3),
                  Vec3(table.x_max, table.y_max, source.table_z + s.shoe.height + 5e-3)};
-  w.die_wall = spec.meshes.size();
   spec.meshes.push_back(dem::fixed_mesh_wall(w.die_field, w.steel, "die"));
   dem::MeshWall shoe_wall = dem::fixed_mesh_wall(w.shoe_field, w.steel, "shoe");
   shoe_wall.motion.start_position = shoe.motion.start_position;
@@ -95,7 +94,7 @@ dem::ModelSpec fill_spec(const scene::PipelineScene& s, FillWalls& w, const DieS
 
 // The distance to the die is 1-Lipschitz, so the true maximum exceeds the sampled one by at most
 // half a grid diagonal. Beyond the field's band, which reads as the band there, the exact distance.
-double largest_inscribed_radius_bound(const mesh::WallField& die, const mesh::TriMesh& die_solid, const mesh::Box& cavity,
+double largest_inscribed_radius_bound(const geometry::WallField& die, const geometry::TriMesh& die_solid, const geometry::Box& cavity,
                                       double table_z, double spacing) {
   const mesh::ExactSurface exact(die_solid);
   const Vec3 size = cavity.size();
@@ -121,7 +120,7 @@ FillWalls prepare_walls(const scene::PipelineScene& s, const DieSource& source, 
   const mesh::DieOptions options = die_options(s, grains, shoe, source);
   w.die = mesh::prepare_die(source.file, options, w.cache);
   for (const std::string& action : w.die.actions) diefill::log::info("{}: {}", source.file.name, action);
-  w.die_field = std::make_shared<const mesh::WallField>(w.die.sdf.wall_field(w.die.solid));
+  w.die_field = std::make_shared<const geometry::WallField>(w.die.sdf.wall_field(w.die.solid));
   w.shoe_field = shoe_field(s, grains, shoe, options.unit, w.cache);
   check_grains_enter(w, source, grains);
   w.spec = fill_spec(s, w, source, grains, shoe, *options.table);

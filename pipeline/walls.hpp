@@ -12,9 +12,9 @@ namespace pipeline {
 
 struct FillWalls {
   mesh::PreparedDie die;
-  std::shared_ptr<const mesh::WallField> die_field, shoe_field;
+  std::shared_ptr<const geometry::WallField> die_field, shoe_field;
   dem::ModelSpec spec;  // laws for the sized grains, gravity, the domain, walls "die" and "shoe"
-  std::size_t die_wall = 0, shoe_wall = 0;  // their places in spec.meshes
+  std::size_t shoe_wall = 0;  // its place in spec.meshes (the shoe pass gives it its motion)
   int powder = 0, steel = 0;  // material indices
   std::filesystem::path cache;  // OUT/.cache
 };
@@ -23,7 +23,7 @@ struct FillWalls {
 FillWalls prepare_walls(const scene::PipelineScene& scene, const DieSource& source, const GrainSizing& grains, const ShoePlan& shoe);
 
 // Upper bound of the radius of the largest sphere the cavity holds below the table.
-double largest_inscribed_radius_bound(const mesh::WallField& die, const mesh::TriMesh& die_solid, const mesh::Box& cavity,
+double largest_inscribed_radius_bound(const geometry::WallField& die, const geometry::TriMesh& die_solid, const geometry::Box& cavity,
                                       double table_z, double spacing);
 
 }  // namespace pipeline

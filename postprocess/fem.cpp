@@ -9,7 +9,7 @@ namespace {
 
 using Tet = std::array<Vec3, 4>;
 
-double volume(const Tet& t) { return std::abs(mesh::tet_volume(t[0], t[1], t[2], t[3])); }
+double volume(const Tet& t) { return std::abs(geometry::tet_volume(t[0], t[1], t[2], t[3])); }
 
 // A triangular prism (a0 a1 a2 below, b0 b1 b2 above, ai joined to bi) as three tetrahedra.
 void add_prism(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0, const Vec3& b1, const Vec3& b2,
@@ -46,8 +46,8 @@ void clip(const Tet& t, int axis, double bound, double side, std::vector<Tet>& o
   }
 }
 
-std::array<Vec3, 4> corners(const mesh::TetMesh& m, std::size_t e) {
-  const mesh::Tet& t = m.tets[e];
+std::array<Vec3, 4> corners(const geometry::TetMesh& m, std::size_t e) {
+  const geometry::Tet& t = m.tets[e];
   return {m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]], m.nodes[t[3]]};
 }
 
@@ -84,7 +84,7 @@ std::vector<Overlap> overlaps(const Tet& t, const VoxelGrid& g) {
 // each element at the density of the cavity it covers, and the mass of that sliver is what the
 // hand-off misses (measured, fem.mass_error_rel). Nothing is averaged beyond a sub-voxel, so the
 // looser layer along the walls stays in the elements there.
-FemFill share_voxels(mesh::TetMesh m, const VoxelGrid& grid, const std::vector<double>& solid,
+FemFill share_voxels(geometry::TetMesh m, const VoxelGrid& grid, const std::vector<double>& solid,
                      const std::vector<double>& cavity_fraction, double material_density) {
   FemFill f;
   f.sub_voxel_m = grid.voxel;
@@ -136,7 +136,7 @@ double tet_box_overlap(const std::array<Vec3, 4>& tet, const Vec3& lo, const Vec
   return v;
 }
 
-FemFill fill_elements(mesh::TetMesh m, const std::vector<Grain>& grains, const CavityShape& cavity, double sub_voxel,
+FemFill fill_elements(geometry::TetMesh m, const std::vector<Grain>& grains, const CavityShape& cavity, double sub_voxel,
                       double material_density) {
   // Every grain whole, up to the table, whose plane is a voxel face (grain volume above it is
   // not in the cavity).
@@ -151,7 +151,7 @@ FemFill fill_elements(mesh::TetMesh m, const std::vector<Grain>& grains, const C
   return share_voxels(std::move(m), grid, solid, cavity_fraction, material_density);
 }
 
-std::vector<double> average_to_nodes(const mesh::TetMesh& m, const std::vector<double>& value,
+std::vector<double> average_to_nodes(const geometry::TetMesh& m, const std::vector<double>& value,
                                      const std::vector<double>& volume) {
   std::vector<double> weight(m.nodes.size(), 0.0), sum(m.nodes.size(), 0.0);
   for (std::size_t e = 0; e < m.tets.size(); ++e)
@@ -176,7 +176,7 @@ QuadraticTets quadratic(const FemFill& f) {
     return it->second;
   };
   constexpr int edges[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
-  for (const mesh::Tet& t : f.mesh.tets) {
+  for (const geometry::Tet& t : f.mesh.tets) {
     std::array<int, 10> e;
     for (int k = 0; k < 4; ++k) e[k] = t[k];
     for (int k = 0; k < 6; ++k) e[4 + k] = middle_of(t[edges[k][0]], t[edges[k][1]]);

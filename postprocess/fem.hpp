@@ -9,13 +9,13 @@
 #include <string>
 #include <vector>
 
-#include "mesh/tetmesh.hpp"
+#include "geometry/tetmesh.hpp"
 #include "postprocess/density.hpp"
 
 namespace post {
 
 struct FemFill {
-  mesh::TetMesh mesh;                   // linear tetrahedra [m]
+  geometry::TetMesh mesh;               // linear tetrahedra [m]
   std::vector<double> element_volume;   // [m³]
   std::vector<double> element_fraction; // solid fraction of each element
   std::vector<double> node_fraction;    // volume-weighted mean of the elements around each node
@@ -41,7 +41,7 @@ struct CavityShape {
 // averaging wider than a sub-voxel and no rescale: Σ fraction × volume differs from the grains'
 // volume in the cavity by what the mesh's chords cut off (0.05 % of the ring's volume) and the
 // sub-voxels' cavity fractions, and that difference is reported, not hidden (issue 44).
-FemFill fill_elements(mesh::TetMesh mesh, const std::vector<Grain>& grains, const CavityShape& cavity, double sub_voxel,
+FemFill fill_elements(geometry::TetMesh mesh, const std::vector<Grain>& grains, const CavityShape& cavity, double sub_voxel,
                       double material_density);
 
 // The volume of a tetrahedron inside the box [lo, hi] (exact up to rounding) [m³].
@@ -64,10 +64,10 @@ QuadraticTets quadratic(const FemFill& fill);
 struct BoundarySets {
   std::vector<std::array<int, 3>> table, floor, walls;
 };
-BoundarySets boundary_sets(const mesh::TetMesh& mesh, double table_z);
+BoundarySets boundary_sets(const geometry::TetMesh& mesh, double table_z);
 
 // Node values from element values: the volume-weighted mean of the elements around each node.
-std::vector<double> average_to_nodes(const mesh::TetMesh& mesh, const std::vector<double>& element_value,
+std::vector<double> average_to_nodes(const geometry::TetMesh& mesh, const std::vector<double>& element_value,
                                      const std::vector<double>& element_volume);
 
 // The hand-off files (docs/INTERFACE.md, "FEM hand-off"), atomically, into `dir`:

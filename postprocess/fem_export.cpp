@@ -150,10 +150,10 @@ std::string vtu(const FemFill& f, const Elements& el) {
 
 }  // namespace
 
-BoundarySets boundary_sets(const mesh::TetMesh& m, double table_z) {
+BoundarySets boundary_sets(const geometry::TetMesh& m, double table_z) {
   std::map<std::array<int, 3>, std::array<int, 4>> faces;  // sorted face -> its face as oriented, and uses
   constexpr int opposite[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};  // outward for positive tets
-  for (const mesh::Tet& t : m.tets)
+  for (const geometry::Tet& t : m.tets)
     for (const auto& f : opposite) {
       std::array<int, 3> key = {t[f[0]], t[f[1]], t[f[2]]};
       std::sort(key.begin(), key.end());

@@ -55,35 +55,36 @@ K text(std::string_view table, std::string_view name, KeyType type, Shapes shape
           [f](P& s, const KeyValue& v) { f(s) = std::remove_reference_t<decltype(f(s))>(std::get<std::string>(v)); }};
 }
 
-// A choice read into the enum (or unit, or direction) of the stage that acts on it: the scene's
-// text is checked against the choices once, at load, and no stage parses it again.
+// A choice read into the enum (or unit, or direction) of the module that acts on it, from that
+// module's table of names (core/choice.hpp): the scene's text is checked against the names once,
+// at load (check_value, before `set`), and no stage parses it again.
 template <class Value, class Member>
-K choice(std::string_view table, std::string_view name, std::vector<std::pair<std::string_view, Value>> options, Shapes shapes,
+K choice(std::string_view table, std::string_view name, std::vector<diefill::Choice<Value>> options, Shapes shapes,
          std::string_view meaning, Member f) {
-  std::vector<std::string_view> texts;
-  for (const auto& option : options) texts.push_back(option.first);
-  return {table, name, KeyType::choice, "", {}, std::move(texts), shapes, meaning,
-          [f, options](const P& s) -> KeyValue {
-            for (const auto& [text, value] : options)
-              if (value == f(s)) return std::string(text);
-            throw std::logic_error("a scene choice holds a value its key does not list");
-          },
-          [f, options](P& s, const KeyValue& v) {
-            for (const auto& [text, value] : options)
-              if (text == std::get<std::string>(v)) f(s) = value;
-          }};
+  std::vector<std::string_view> names;
+  for (const auto& option : options) names.push_back(option.name);
+  const auto find = [options](const auto& matches) {
+    for (const auto& option : options)
+      if (matches(option)) return option;
+    throw std::logic_error("a scene choice holds a value or a name its key does not list");
+  };
+  return {table, name, KeyType::choice, "", {}, std::move(names), shapes, meaning,
+          [f, find](const P& s) -> KeyValue { return std::string(find([&](const auto& o) { return o.value == f(s); }).name); },
+          [f, find](P& s, const KeyValue& v) { f(s) = find([&](const auto& o) { return o.name == std::get<std::string>(v); }).value; }};
 }
 
 template <class Value, std::size_t N>
-std::vector<std::pair<std::string_view, Value>> options_of(const std::array<std::pair<std::string_view, Value>, N>& table) {
+std::vector<diefill::Choice<Value>> options_of(const std::array<diefill::Choice<Value>, N>& table) {
   return {table.begin(), table.end()};
 }
 
-const std::vector<std::pair<std::string_view, std::optional<mesh::LengthUnit>>> unit_or_auto = {
-    {"auto", std::nullopt}, {"mm", mesh::LengthUnit::mm}, {"m", mesh::LengthUnit::m}, {"in", mesh::LengthUnit::in}};
-const std::vector<std::pair<std::string_view, std::optional<mesh::Up>>> up_choices = {
-    {"auto", std::nullopt}, {"+z", mesh::Up{2, 1}}, {"-z", mesh::Up{2, -1}}, {"+x", mesh::Up{0, 1}},
-    {"-x", mesh::Up{0, -1}}, {"+y", mesh::Up{1, 1}}, {"-y", mesh::Up{1, -1}}};
+// The table's choices after "auto": unset, found or guessed by the stage.
+template <class Value, std::size_t N>
+std::vector<diefill::Choice<std::optional<Value>>> auto_or(const std::array<diefill::Choice<Value>, N>& table) {
+  std::vector<diefill::Choice<std::optional<Value>>> options = {{"auto", std::nullopt}};
+  for (const auto& c : table) options.push_back({c.name, c.value});
+  return options;
+}
 
 dem::ModelSpec& spec_of(P& s) { return s.spec; }
 
@@ -93,28 +94,28 @@ KeyTable<P> make_pipeline_keys() {
   const Shapes die = Shapes::die, settling = Shapes::settling, run = Shapes::run, nothing = Shapes::nothing;
   KeyTable<P> k = {
       text("die", "file", KeyType::path, die, "the die's cavity mesh (relative to the scene file)", member(&P::die, &DieSettings::file)),
-      choice("die", "units", unit_or_auto, die,
-           "the mesh file's length unit (files store none); auto: guessed from its size, 3 or more across mm, 1 to 3 "
-           "inches, under 1 metres (a warning says so unless mm)",
-           member(&P::die, &DieSettings::units)),
-      choice("die", "up", up_choices, die,
-           "the way the cavity's opening faces in the file; the die is turned so that it faces up (+z). auto: +z "
-           "when the flat faces at the top cover half of the part's outline seen from above, else the extreme whose "
-           "flat faces cover the largest share of the outline along their axis",
-           member(&P::die, &DieSettings::up)),
-      choice<mesh::Parting>("die", "parting", {{"auto", mesh::Parting::automatic}, {"opening", mesh::Parting::opening}, {"widest", mesh::Parting::widest}}, die,
-           "where the die table meets the part: opening, at its flat face (a part with none is refused); widest, at "
-           "its widest section across the up axis, the cavity being the part below (the upper punch forms the "
-           "rest); auto: opening when the part has a flat face at an extreme, else widest with the part lying flat "
-           "(up: the axis of its largest outline)",
-           member(&P::die, &DieSettings::parting)),
+      choice("die", "units", auto_or(geometry::length_units), die,
+             "the mesh file's length unit (files store none); auto: guessed from its size, 3 or more across mm, 1 to 3 "
+             "inches, under 1 metres (a warning says so unless mm)",
+             member(&P::die, &DieSettings::units)),
+      choice("die", "up", auto_or(mesh::directions), die,
+             "the way the cavity's opening faces in the file; the die is turned so that it faces up (+z). auto: +z "
+             "when the flat faces at the top cover half of the part's outline seen from above, else the extreme whose "
+             "flat faces cover the largest share of the outline along their axis",
+             member(&P::die, &DieSettings::up)),
+      choice("die", "parting", options_of(mesh::partings), die,
+                            "where the die table meets the part: opening, at its flat face (a part with none is refused); widest, at "
+                            "its widest section across the up axis, the cavity being the part below (the upper punch forms the "
+                            "rest); auto: opening when the part has a flat face at an extreme, else widest with the part lying flat "
+                            "(up: the axis of its largest outline)",
+                            member(&P::die, &DieSettings::parting)),
       integer("die", "part", {0, 1e6}, die,
               "for a file that holds an assembly (bodies that share no vertex): the body the die is for, numbered by "
               "enclosed volume, largest first; 0: the whole file as one part",
               member(&P::die, &DieSettings::part)),
-      choice<mesh::WallRole>("die", "role", {{"cavity", mesh::WallRole::cavity}}, die,
-           "the mesh is the part's shape, open at the die table (its highest z); `diefill sdf --role` takes tools too",
-           member(&P::die, &DieSettings::role)),
+      choice<mesh::WallRole>("die", "role", {{"cavity", mesh::WallRole::cavity}}, die,  // the pipeline fills a cavity
+                             "the mesh is the part's shape, open at the die table (its highest z); `diefill sdf --role` takes tools too",
+                             member(&P::die, &DieSettings::role)),
       number("die", "voxel_fraction", "largest grain radii", {0.05, 4}, die,
              "SDF voxel edge: contacts are exact either way, finer voxels find them faster near curved walls",
              member(&P::die, &DieSettings::voxel_fraction)),
@@ -157,8 +158,8 @@ KeyTable<P> make_pipeline_keys() {
            "a grain shape: rigid multi-sphere clumps scaled to the grain diameter (volume-equivalent)", member(&P::powder, &PowderSettings::shape_mesh)),
       number("powder.shape", "tolerance", "", {0.01, 0.5}, settling, "the clump's volume and Hausdorff error",
              member(&P::powder, &PowderSettings::shape_tolerance)),
-      choice<mesh::LengthUnit>("powder.shape", "units", {{"mm", mesh::LengthUnit::mm}, {"m", mesh::LengthUnit::m}, {"in", mesh::LengthUnit::in}}, settling, "the grain mesh's length unit",
-           member(&P::powder, &PowderSettings::shape_units)),
+      choice("powder.shape", "units", options_of(geometry::length_units), settling, "the grain mesh's length unit",
+                                   member(&P::powder, &PowderSettings::shape_units)),
   };
   add_physics_keys<P>(k, spec_of, settling);
   const auto physics_end = std::stable_partition(k.begin(), k.end(), [](const K& key) { return key.table != "simulation"; });

@@ -11,7 +11,8 @@
 #include <vector>
 
 #include "dem/model.hpp"
-#include "mesh/die.hpp"
+#include "mesh/orientation.hpp"
+#include "mesh/wall_role.hpp"
 #include "scene/choices.hpp"
 #include "scene/scene_keys.hpp"
 
@@ -24,12 +25,12 @@ namespace scene {
 // [die] the die's mesh and how to read it (the mesh stage)
 struct DieSettings {
   std::filesystem::path file;                 // the mesh
-  std::optional<mesh::LengthUnit> units;      // unset: guessed from the mesh's size
+  std::optional<geometry::LengthUnit> units;  // unset: guessed from the mesh's size
   mesh::WallRole role = mesh::WallRole::cavity;
   std::optional<mesh::Up> up;                 // unset: found (mesh::find_opening)
   mesh::Parting parting = mesh::Parting::automatic;
   int part = 0;                               // the body of an assembly's file (mesh::DieFile::part); 0: the whole file
-  double voxel_fraction = 0.25;               // SDF voxel edge [largest grain radii] (mesh::default_voxel_fraction)
+  double voxel_fraction = 0.25;               // SDF voxel edge [largest grain radii] (as mesh::default_voxel_fraction)
 };
 
 // [shoe] the feeding shoe and the powder in it (metres)
@@ -58,7 +59,7 @@ struct PowderSettings {
   std::size_t max_grains = 60000;     // coarser grains (larger α) beyond this, with a warning
   std::string shape_mesh;             // clumps (issue 6): a grain surface mesh
   double shape_tolerance = 0.05;
-  mesh::LengthUnit shape_units = mesh::LengthUnit::mm;
+  geometry::LengthUnit shape_units = geometry::LengthUnit::mm;
   double grain_diameter() const { return coarse_graining * particle_diameter; }
 };
 

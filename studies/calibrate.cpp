@@ -89,9 +89,9 @@ dem::ModelSpec funnel_walls(const Powder& p, const Funnel& f) {
   const std::vector<std::array<double, 2>> profile = {{f.orifice_radius, -f.thickness}, {outer, -f.thickness}, {outer, top},
                                                       {f.top_radius, top},           {f.top_radius, f.cone_height},
                                                       {f.orifice_radius, 0}};
-  const mesh::TriMesh solid = mesh::revolved_solid(profile, mesh::circle_segments(f.orifice_radius, 0.02 * d));
+  const geometry::TriMesh solid = mesh::revolved_solid(profile, mesh::circle_segments(f.orifice_radius, 0.02 * d));
   dem::ModelSpec spec = p.spec;
-  spec.meshes = {dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(mesh::contact_wall_field(solid, p.r_max())), p.wall,
+  spec.meshes = {dem::fixed_mesh_wall(std::make_shared<const geometry::WallField>(mesh::contact_wall_field(solid, p.r_max())), p.wall,
                                       "funnel")};
   const double reach = outer + 2 * d;
   spec.domain = {dem::Vec3(-reach, -reach, -f.thickness - 8 * d), dem::Vec3(reach, reach, top + 2 * d)};

@@ -235,7 +235,7 @@ DeepDie deep_die(const DischargeSizes& z, double d, double bulk_density, Output&
   std::filesystem::create_directories(out.work());
   mesh::write_stl(
       mesh::box_solid(Vec3(-0.5 * die.opening, -0.5 * die.opening, -die.depth), Vec3(0.5 * die.opening, 0.5 * die.opening, 0)),
-      die.bin, mesh::LengthUnit::mm, "diefill discharge study: deep die");
+      die.bin, geometry::LengthUnit::mm, "diefill discharge study: deep die");
   die.capacity = bulk_density * die.opening * die.opening * die.depth;
   return die;
 }
@@ -257,7 +257,7 @@ ShoeRuns run_moving_shoe(const scene::PipelineScene& scene, const DischargeSizes
   ShoeRuns shoe;
   for (double v : z.speeds) {
     scene::PipelineScene s = scene;
-    s.die.units = mesh::LengthUnit::mm;
+    s.die.units = geometry::LengthUnit::mm;
     s.motion.speed = v;
     s.motion.acceleration = 10;  // about 1 g: the shoe reaches its speed before the opening
     s.motion.start_gap = v * v / (2 * s.motion.acceleration) + 2e-3;

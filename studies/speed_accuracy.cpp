@@ -85,8 +85,8 @@ constexpr double common_voxel = 2e-3;
 struct CommonGrid {
   std::filesystem::path ring;
   mesh::PreparedDie die;
-  mesh::WallField walls;
-  pipeline::DensitySettings density;
+  geometry::WallField walls;
+  pipeline::DensityOptions density;
 };
 
 CommonGrid common_grid(const Output& out) {

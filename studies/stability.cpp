@@ -140,11 +140,11 @@ std::string voxel_run(const Powder& powder, double voxel_over_radius, const std:
   const std::filesystem::path ring = ring_mesh(work);
   const mesh::DieOptions options = mesh::die_options_for_grains(r, 0.5 * r, voxel_over_radius * r);
   const mesh::PreparedDie die = mesh::prepare_die(ring, options, work / ".cache");
-  auto field = std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid));
+  auto field = std::make_shared<const geometry::WallField>(die.sdf.wall_field(die.solid));
   dem::ModelSpec spec = powder.spec;
   spec.skin = 0.5 * r;  // the default comes from the grains, and the first model has none
   spec.meshes = {dem::fixed_mesh_wall(field, powder.wall, "die")};
-  const mesh::Box box = mesh::bounding_box(die.cavity);
+  const geometry::Box box = geometry::bounding_box(die.cavity);
   // Wide enough that only a grain through the die leaves it (downwards).
   spec.domain = {box.lo - Vec3(25e-3, 25e-3, 5e-3), box.hi + Vec3(25e-3, 25e-3, 30e-3)};
   spec.max_impact_speed = std::max(spec.max_impact_speed, std::sqrt(2 * spec.gravity.norm() * 25e-3));

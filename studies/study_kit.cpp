@@ -29,7 +29,7 @@ Powder powder_of(const scene::PipelineScene& scene) {
 }
 
 dem::MeshWall block_wall(const Vec3& lo, const Vec3& hi, double r_max, int material, const std::string& name) {
-  return dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(mesh::contact_wall_field(mesh::box_solid(lo, hi), r_max)),
+  return dem::fixed_mesh_wall(std::make_shared<const geometry::WallField>(mesh::contact_wall_field(mesh::box_solid(lo, hi), r_max)),
                               material, name);
 }
 
@@ -37,7 +37,7 @@ std::filesystem::path ring_mesh(const std::filesystem::path& work) {
   const std::filesystem::path ring = work / "ring.stl";
   if (!std::filesystem::exists(ring)) {
     std::filesystem::create_directories(work);
-    mesh::write_stl(mesh::bundled_die("ring"), ring, mesh::LengthUnit::mm, "diefill ring die");
+    mesh::write_stl(mesh::bundled_die("ring"), ring, geometry::LengthUnit::mm, "diefill ring die");
   }
   return ring;
 }

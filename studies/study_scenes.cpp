@@ -205,11 +205,11 @@ HeapRun run_heap(const Powder& p, const Heap& h, const std::string& label) {
   base_material.name = "heap base";
   spec.materials.push_back(base_material);
   const int rough = int(spec.materials.size()) - 1;
-  const mesh::TriMesh dish = mesh::ring_cavity(2 * h.pedestal_radius, 0, d, 0.01 * d);
+  const geometry::TriMesh dish = mesh::ring_cavity(2 * h.pedestal_radius, 0, d, 0.01 * d);
   mesh::TableExtent table = mesh::table_around(dish, 0.25 * d);
   table.thickness = base;
   const mesh::ToolMesh pedestal = mesh::tool_from_cavity(dish, table, "heap pedestal");
-  spec.meshes = {dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(mesh::contact_wall_field(pedestal.mesh, r)), rough, "pedestal")};
+  spec.meshes = {dem::fixed_mesh_wall(std::make_shared<const geometry::WallField>(mesh::contact_wall_field(pedestal.mesh, r)), rough, "pedestal")};
 
   // Batches every 10 ms: a stream of the asked rate, each batch dropped just above the heap.
   const double batch_period = 0.01;

@@ -40,13 +40,13 @@ inline dem::ModelSpec spec_with(std::vector<dem::Material> materials, dem::Vec3 
 }
 
 // The wall field of a closed solid given as a mesh (the tool side of the walls).
-inline std::shared_ptr<const mesh::WallField> wall_field_of(const mesh::TriMesh& solid, double voxel) {
+inline std::shared_ptr<const geometry::WallField> wall_field_of(const geometry::TriMesh& solid, double voxel) {
   mesh::SdfOptions o;
   o.voxel_m = voxel;
   o.exterior_band_m = 8 * voxel;
   o.interior_band_m = 2 * voxel;
   const mesh::SdfGrid sdf = mesh::build_sdf(solid, o);
-  return std::make_shared<const mesh::WallField>(sdf.wall_field(solid));
+  return std::make_shared<const geometry::WallField>(sdf.wall_field(solid));
 }
 
 }  // namespace test

@@ -4,13 +4,13 @@
 
 #include <string>
 
+#include "geometry/trimesh.hpp"
 #include "mesh/shapes.hpp"
-#include "mesh/trimesh.hpp"
 
 namespace test {
 
 // Unit box [0, 10]^3 mm as ASCII STL text, optionally with some faces left out or reversed.
-inline std::string ascii_stl(const mesh::TriMesh& m, double scale = 1e3, const std::string& name = "part") {
+inline std::string ascii_stl(const geometry::TriMesh& m, double scale = 1e3, const std::string& name = "part") {
   std::string s = "solid " + name + "\n";
   for (const auto& t : m.triangles) {
     s += "  facet normal 0 0 0\n    outer loop\n";
@@ -23,17 +23,17 @@ inline std::string ascii_stl(const mesh::TriMesh& m, double scale = 1e3, const s
   return s + "endsolid " + name + "\n";
 }
 
-inline mesh::TriMesh box_mm(double lo, double hi) {
-  return mesh::box_solid(mesh::Vec3::Constant(lo * 1e-3), mesh::Vec3::Constant(hi * 1e-3));
+inline geometry::TriMesh box_mm(double lo, double hi) {
+  return mesh::box_solid(geometry::Vec3::Constant(lo * 1e-3), geometry::Vec3::Constant(hi * 1e-3));
 }
 
-inline mesh::TriMesh reversed(mesh::TriMesh m) {
+inline geometry::TriMesh reversed(geometry::TriMesh m) {
   for (auto& t : m.triangles) std::swap(t[1], t[2]);
   return m;
 }
 
-inline mesh::TriMesh joined(const mesh::TriMesh& a, const mesh::TriMesh& b) {
-  mesh::TriMesh m = a;
+inline geometry::TriMesh joined(const geometry::TriMesh& a, const geometry::TriMesh& b) {
+  geometry::TriMesh m = a;
   const int base = int(m.vertices.size());
   m.vertices.insert(m.vertices.end(), b.vertices.begin(), b.vertices.end());
   for (auto t : b.triangles) m.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});

@@ -44,8 +44,8 @@ TEST(Cli, UnknownOptionIsBadInput) {
 TEST(Cli, SdfRejectsBadMeshesClearly) {
   test::TempDir dir;
   const std::string d = dir.path().string();
-  const mesh::TriMesh ring = mesh::bundled_die("ring");
-  mesh::write_stl(ring, dir / "ring.stl", mesh::LengthUnit::mm, "ring");
+  const geometry::TriMesh ring = mesh::bundled_die("ring");
+  mesh::write_stl(ring, dir / "ring.stl", geometry::LengthUnit::mm, "ring");
   const std::string whole = test::read_text(dir / "ring.stl");
 
   expect_bad_input("sdf " + d + "/missing.stl", "missing.stl", "no such file");
@@ -64,7 +64,7 @@ TEST(Cli, SdfRejectsBadMeshesClearly) {
                    "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
                    "endloop\nendfacet\nendsolid t\n");
   expect_bad_input("sdf " + d + "/triangle.stl", "triangle.stl", "cannot enclose a solid");
-  mesh::TriMesh open_box = test::box_mm(0, 10);
+  geometry::TriMesh open_box = test::box_mm(0, 10);
   open_box.triangles.resize(10);
   test::write_text(dir / "open_box.stl", test::ascii_stl(open_box));
   expect_bad_input("sdf --role tool " + d + "/open_box.stl", "open_box.stl", "boundary edges");
@@ -72,7 +72,7 @@ TEST(Cli, SdfRejectsBadMeshesClearly) {
   expect_bad_input("sdf --role tool " + d + "/flipped.stl", "flipped.stl", "inside out");
   test::write_text(dir / "nested.stl", test::ascii_stl(test::joined(test::box_mm(0, 10), test::box_mm(2, 8))));
   expect_bad_input("sdf --role tool " + d + "/nested.stl", "nested.stl", "inside another shell");
-  mesh::write_stl(ring, dir / "ring_in_metres.stl", mesh::LengthUnit::m, "ring, m");
+  mesh::write_stl(ring, dir / "ring_in_metres.stl", geometry::LengthUnit::m, "ring, m");
   // Declared millimetres, a ring stored in metres is too small for the voxel (undeclared, its
   // size says metres: docs/MESHES.md, "Units").
   expect_bad_input("sdf --units mm " + d + "/ring_in_metres.stl", "ring_in_metres.stl", "--units m");
@@ -91,7 +91,7 @@ TEST(Cli, SdfRejectsBadMeshesClearly) {
 // naming the flag.
 TEST(Cli, LengthFlagsTakeAUnit) {
   test::TempDir dir;
-  mesh::write_stl(mesh::bundled_die("disc"), dir / "disc.stl", mesh::LengthUnit::mm, "disc");
+  mesh::write_stl(mesh::bundled_die("disc"), dir / "disc.stl", geometry::LengthUnit::mm, "disc");
   const auto grid_line = [&](const std::string& voxel) {
     const test::Run run = test::run_diefill("sdf " + (dir / "disc.stl").string() + " --voxel " + voxel + " -o " + (dir / "d.vdb").string());
     EXPECT_EQ(run.status, 0) << run.output;
@@ -108,7 +108,7 @@ TEST(Cli, LengthFlagsTakeAUnit) {
 
 TEST(Cli, FailedSdfKeepsTheEarlierOutput) {
   test::TempDir dir;
-  mesh::write_stl(mesh::bundled_die("disc"), dir / "disc.stl", mesh::LengthUnit::mm, "disc");
+  mesh::write_stl(mesh::bundled_die("disc"), dir / "disc.stl", geometry::LengthUnit::mm, "disc");
   const std::string out = (dir / "disc.vdb").string();
   // Coarse voxels: this test is about files, and under the sanitizers a fine grid takes minutes.
   ASSERT_EQ(test::run_diefill("sdf " + (dir / "disc.stl").string() + " --voxel 0.5 -o " + out).status, 0);
@@ -140,11 +140,11 @@ void write_scene(const test::TempDir& dir, const std::string& extra_simulation =
 // would fall out of the domain.
 TEST(CliSimulate, AMeshWallHoldsTheGrainsOnItsFloor) {
   test::TempDir dir;
-  const mesh::TriMesh disc = mesh::bundled_die("disc");
-  mesh::write_stl(disc, dir / "disc.stl", mesh::LengthUnit::mm, "disc");
-  mesh::Vec3 lo = disc.vertices.front(), hi = lo;
-  for (const mesh::Vec3& v : disc.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
-  const mesh::Vec3 centre = 0.5 * (lo + hi);
+  const geometry::TriMesh disc = mesh::bundled_die("disc");
+  mesh::write_stl(disc, dir / "disc.stl", geometry::LengthUnit::mm, "disc");
+  geometry::Vec3 lo = disc.vertices.front(), hi = lo;
+  for (const geometry::Vec3& v : disc.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  const geometry::Vec3 centre = 0.5 * (lo + hi);
   const double r = 2e-3;  // a coarse wall field (its voxel a quarter of the radius): seconds under the sanitizers
   test::write_text(dir / "particles.csv", fmt::format("id,x,y,z,vx,vy,vz,wx,wy,wz,radius\n0,{},{},{},0,0,0,0,0,0,{}\n", centre.x(),
                                                       centre.y(), lo.z() + 4 * r, r));

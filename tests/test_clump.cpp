@@ -15,16 +15,16 @@
 #include "mesh/shapes.hpp"
 #include "support.hpp"
 
-using mesh::Vec3;
+using geometry::Vec3;
 
 namespace {
 
 constexpr double pi = std::numbers::pi;
 
 // Icosahedron subdivided `levels` times, vertices pushed onto the sphere (c, r): outward.
-mesh::TriMesh icosphere(int levels, double r, const Vec3& c = Vec3::Zero()) {
+geometry::TriMesh icosphere(int levels, double r, const Vec3& c = Vec3::Zero()) {
   const double t = (1 + std::sqrt(5.0)) / 2;
-  mesh::TriMesh m;
+  geometry::TriMesh m;
   for (const Vec3& v : {Vec3(-1, t, 0), Vec3(1, t, 0), Vec3(-1, -t, 0), Vec3(1, -t, 0),
                         Vec3(0, -1, t), Vec3(0, 1, t), Vec3(0, -1, -t), Vec3(0, 1, -t),
                         Vec3(t, 0, -1), Vec3(t, 0, 1), Vec3(-t, 0, -1), Vec3(-t, 0, 1)})
@@ -41,8 +41,8 @@ mesh::TriMesh icosphere(int levels, double r, const Vec3& c = Vec3::Zero()) {
       m.vertices.push_back((m.vertices[std::size_t(a)] + m.vertices[std::size_t(b)]).normalized());
       return midpoints[key] = int(m.vertices.size()) - 1;
     };
-    std::vector<mesh::Triangle> finer;
-    for (const mesh::Triangle& f : m.triangles) {
+    std::vector<geometry::Triangle> finer;
+    for (const geometry::Triangle& f : m.triangles) {
       const int ab = midpoint(f[0], f[1]), bc = midpoint(f[1], f[2]), ca = midpoint(f[2], f[0]);
       finer.insert(finer.end(), {{f[0], ab, ca}, {f[1], bc, ab}, {f[2], ca, bc}, {ab, bc, ca}});
     }
@@ -57,8 +57,8 @@ double relative(double value, double expected) {
 }
 
 // Checks that hold for every template of `grain` that met its tolerance; prints the record.
-void expect_converged(const std::string& name, const mesh::TriMesh& grain,
-                      const mesh::ClumpTemplate& c, double seconds) {
+void expect_converged(const std::string& name, const geometry::TriMesh& grain,
+                      const geometry::ClumpTemplate& c, double seconds) {
   ASSERT_FALSE(c.history.empty());
   EXPECT_EQ(c.history.back().spheres, int(c.spheres.size()));
   EXPECT_LE(c.volume_error, c.tolerance) << name;
@@ -80,10 +80,10 @@ void expect_converged(const std::string& name, const mesh::TriMesh& grain,
   EXPECT_LE(c.inertia_principal_per_density.y(), c.inertia_principal_per_density.z()) << name;
   // No sphere reaches past the grain's box (in the principal frame) by more than the Hausdorff
   // tolerance allows.
-  mesh::Box box;
+  geometry::Box box;
   for (const Vec3& v : grain.vertices) box.extend(R * (v - c.mesh_centroid));
   const double slack = c.tolerance * c.equivalent_diameter_m;
-  for (const mesh::ClumpSphere& s : c.spheres) {
+  for (const geometry::ClumpSphere& s : c.spheres) {
     EXPECT_GT(s.radius, 0) << name;
     EXPECT_TRUE((s.centre.array() - s.radius >= box.lo.array() - slack).all() &&
                 (s.centre.array() + s.radius <= box.hi.array() + slack).all())
@@ -124,10 +124,10 @@ TEST(MassProperties, BoxMatchesClosedForm) {
 
 TEST(MassProperties, MovedBoxInertiaTransformsAsATensor) {
   const Vec3 half(1e-3, 1.5e-3, 2.5e-3);
-  const mesh::TriMesh box = mesh::box_solid(-half, half);
+  const geometry::TriMesh box = mesh::box_solid(-half, half);
   const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
   const Vec3 t(0.05, -0.02, 0.3);
-  mesh::TriMesh moved = box;
+  geometry::TriMesh moved = box;
   for (Vec3& v : moved.vertices) v = R * v + t;
   const mesh::MassProperties p0 = mesh::mass_properties(box), p = mesh::mass_properties(moved);
   EXPECT_LT(relative(p.volume, p0.volume), 1e-12);
@@ -140,7 +140,7 @@ TEST(MassProperties, TetrahedronMatchesTonon) {
   // Tonon (2004), J. Math. Stat. 1(1): the second moment of a tetrahedron about the origin is
   // V/20 (Σ v vᵀ + s sᵀ), s the sum of its four vertices.
   const std::vector<Vec3> v = {{0.1, 0.2, -0.3}, {1.3, 0.1, 0.2}, {0.4, 1.1, 0.3}, {0.2, 0.5, 1.4}};
-  mesh::TriMesh tet{v, {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}}};
+  geometry::TriMesh tet{v, {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}}};
   const double volume = (v[1] - v[0]).cross(v[2] - v[0]).dot(v[3] - v[0]) / 6;
   ASSERT_GT(volume, 0);
   const Vec3 s = v[0] + v[1] + v[2] + v[3], centroid = s / 4;
@@ -175,8 +175,8 @@ TEST(MassProperties, TessellatedSphereConvergesAtSecondOrder) {
 TEST(Clump, TessellatedSphereIsOneSphere) {
   const double r = 1e-3;
   const Vec3 centre(3e-3, -2e-3, 5e-3);
-  mesh::ClumpTemplate c;
-  const mesh::TriMesh sphere = icosphere(3, r, centre);
+  geometry::ClumpTemplate c;
+  const geometry::TriMesh sphere = icosphere(3, r, centre);
   const double seconds = timed([&] { c = mesh::make_clump(sphere, {.tolerance = 0.03}); });
   ASSERT_EQ(c.spheres.size(), 1u);
   EXPECT_LT((c.mesh_centroid - centre).norm(), 1e-9);
@@ -189,14 +189,14 @@ TEST(Clump, CapsuleSpheresLieOnItsAxis) {
   REQUIRE_SHARED_MESHES();
   // Unitless in the file (r = 1, length 3): read as millimetres, a small tablet.
   const auto path = test::shared_meshes() / "grains" / "capsule_trimesh.obj";
-  const mesh::TriMesh capsule = mesh::import_mesh(path, {mesh::LengthUnit::mm}).mesh;
+  const geometry::TriMesh capsule = mesh::import_mesh(path, {geometry::LengthUnit::mm}).mesh;
   const double length = 3e-3;
-  mesh::ClumpTemplate c;
+  geometry::ClumpTemplate c;
   const double seconds = timed([&] { c = mesh::make_clump(capsule, {.tolerance = 0.02}); });
   expect_converged("capsule", capsule, c, seconds);
   EXPECT_LE(c.volume_error, 0.02);
   // Ascending moments: the first principal axis is the long one.
-  for (const mesh::ClumpSphere& s : c.spheres) {
+  for (const geometry::ClumpSphere& s : c.spheres) {
     EXPECT_LT(std::hypot(s.centre.y(), s.centre.z()), 0.02 * length);
     EXPECT_LT(std::abs(s.centre.x()), 0.5 * length);
   }
@@ -204,8 +204,8 @@ TEST(Clump, CapsuleSpheresLieOnItsAxis) {
 }
 
 TEST(Clump, CubeErrorsFallToTheTolerance) {
-  const mesh::TriMesh cube = mesh::box_solid(Vec3::Zero(), Vec3::Constant(10e-3));
-  mesh::ClumpTemplate c;
+  const geometry::TriMesh cube = mesh::box_solid(Vec3::Zero(), Vec3::Constant(10e-3));
+  geometry::ClumpTemplate c;
   const double seconds = timed([&] { c = mesh::make_clump(cube, {.tolerance = 0.05}); });
   expect_converged("cube 10 mm", cube, c, seconds);
   EXPECT_GT(c.spheres.size(), 1u);
@@ -213,22 +213,22 @@ TEST(Clump, CubeErrorsFallToTheTolerance) {
 }
 
 TEST(Clump, SameInputSameTemplate) {
-  const mesh::TriMesh box = mesh::box_solid(Vec3::Zero(), Vec3(10e-3, 6e-3, 4e-3));
+  const geometry::TriMesh box = mesh::box_solid(Vec3::Zero(), Vec3(10e-3, 6e-3, 4e-3));
   const mesh::ClumpOptions o{.tolerance = 0.1, .seed = 7};
   const std::string first = mesh::clump_json(mesh::make_clump(box, o));
   EXPECT_EQ(first, mesh::clump_json(mesh::make_clump(box, o)));
   REQUIRE_SHARED_MESHES();
   // A scanned stone also takes Hausdorff steps, whose candidates are made on the fly.
-  const mesh::TriMesh stone =
+  const geometry::TriMesh stone =
       mesh::import_mesh(test::shared_meshes() / "grains" / "stone_0_ibois_ascii.ply",
-                        {mesh::LengthUnit::m})
+                        {geometry::LengthUnit::m})
           .mesh;
   EXPECT_EQ(mesh::clump_json(mesh::make_clump(stone, {})),
             mesh::clump_json(mesh::make_clump(stone, {})));
 }
 
 TEST(Clump, JsonCarriesTheInterfaceFields) {
-  const mesh::ClumpTemplate c =
+  const geometry::ClumpTemplate c =
       mesh::make_clump(mesh::box_solid(Vec3::Zero(), Vec3(10e-3, 6e-3, 4e-3)), {.tolerance = 0.1});
   const auto j = nlohmann::json::parse(mesh::clump_json(c));
   ASSERT_EQ(j["spheres"].size(), c.spheres.size());
@@ -245,7 +245,7 @@ TEST(Clump, JsonCarriesTheInterfaceFields) {
 }
 
 TEST(Clump, RefusesOpenMeshesAndUnreachableTolerances) {
-  mesh::TriMesh open = mesh::box_solid(Vec3::Zero(), Vec3::Constant(1e-3));
+  geometry::TriMesh open = mesh::box_solid(Vec3::Zero(), Vec3::Constant(1e-3));
   open.triangles.pop_back();
   try {
     mesh::make_clump(open, {});
@@ -267,7 +267,7 @@ namespace {
 
 struct SharedGrain {
   const char* file;
-  mesh::LengthUnit unit;  // from SOURCES.md: files store none
+  geometry::LengthUnit unit;  // from SOURCES.md: files store none
   double tolerance;
   int max_spheres;
   bool needs_repair;  // not a closed solid as read: repaired as `diefill clump` does first
@@ -275,16 +275,16 @@ struct SharedGrain {
 
 // Every grain of ../shared/data/meshes/grains at the default tolerance 0.05.
 const SharedGrain shared_grains[] = {
-    {"capsule_trimesh.obj", mesh::LengthUnit::mm, 0.05, 64, false},  // its zero-area pole faces weld away
-    {"regolith_particle_1_chrono.obj", mesh::LengthUnit::m, 0.05, 64, false},
-    {"stone_0_ibois_ascii.ply", mesh::LengthUnit::m, 0.05, 64, false},
-    {"stone_073ac15d_ibois.ply", mesh::LengthUnit::m, 0.05, 64, false},
-    {"stone_E22_ibois.ply", mesh::LengthUnit::m, 0.05, 64, false},
+    {"capsule_trimesh.obj", geometry::LengthUnit::mm, 0.05, 64, false},  // its zero-area pole faces weld away
+    {"regolith_particle_1_chrono.obj", geometry::LengthUnit::m, 0.05, 64, false},
+    {"stone_0_ibois_ascii.ply", geometry::LengthUnit::m, 0.05, 64, false},
+    {"stone_073ac15d_ibois.ply", geometry::LengthUnit::m, 0.05, 64, false},
+    {"stone_E22_ibois.ply", geometry::LengthUnit::m, 0.05, 64, false},
     // 3 non-manifold edges, a double-sided triangle, a shell inside and a surface folded through
     // itself (over a hundred intersecting triangle pairs): repair re-meshes the folds (moving the
     // outer surface by 0.64 mm, 0.4 % of its size) and unites the rest. A flat slab: its
     // Hausdorff error needs more than the default 64 spheres.
-    {"stone_A13_ibois_nonmanifold.ply", mesh::LengthUnit::mm, 0.05, 128, true},
+    {"stone_A13_ibois_nonmanifold.ply", geometry::LengthUnit::mm, 0.05, 128, true},
 };
 
 void PrintTo(const SharedGrain& g, std::ostream* os) { *os << g.file; }
@@ -296,7 +296,7 @@ class SharedGrainClump : public ::testing::TestWithParam<SharedGrain> {};
 TEST_P(SharedGrainClump, ErrorsFallToTheTolerance) {
   REQUIRE_SHARED_MESHES();
   const SharedGrain& g = GetParam();
-  mesh::TriMesh grain = mesh::import_mesh(test::shared_meshes() / "grains" / g.file, {g.unit}).mesh;
+  geometry::TriMesh grain = mesh::import_mesh(test::shared_meshes() / "grains" / g.file, {g.unit}).mesh;
   if (g.needs_repair) {
     try {
       mesh::make_clump(grain, {.tolerance = g.tolerance});
@@ -312,7 +312,7 @@ TEST_P(SharedGrainClump, ErrorsFallToTheTolerance) {
     std::printf("%-40s repaired: surface moved by %.3g mm\n", g.file, repaired.hausdorff_m * 1e3);
     grain = repaired.mesh;
   }
-  mesh::ClumpTemplate c;
+  geometry::ClumpTemplate c;
   const double seconds =
       timed([&] { c = mesh::make_clump(grain, {.tolerance = g.tolerance, .max_spheres = g.max_spheres}); });
   expect_converged(g.file, grain, c, seconds);

@@ -29,8 +29,8 @@ namespace {
 // Volume and principal moments of unit-density solid spheres at `centres`, overlaps counted
 // twice: a stand-in for a grain mesh. The layouts below are symmetric, so the moments about
 // x, y, z are the principal ones.
-mesh::ClumpTemplate template_of(const std::vector<Vec3>& centres, double r) {
-  mesh::ClumpTemplate t;
+geometry::ClumpTemplate template_of(const std::vector<Vec3>& centres, double r) {
+  geometry::ClumpTemplate t;
   const double v = 4.0 / 3.0 * std::numbers::pi * r * r * r;
   for (const Vec3& c : centres) {
     t.spheres.push_back({c, r});
@@ -41,11 +41,11 @@ mesh::ClumpTemplate template_of(const std::vector<Vec3>& centres, double r) {
 }
 
 // Four overlapping spheres in a cross longer along x than y: I1 < I2 < I3 about x, y, z.
-mesh::ClumpTemplate cross(double r = 0.5e-3) {
+geometry::ClumpTemplate cross(double r = 0.5e-3) {
   return template_of({Vec3(1.6 * r, 0, 0), Vec3(-1.6 * r, 0, 0), Vec3(0, 0.7 * r, 0), Vec3(0, -0.7 * r, 0)}, r);
 }
 
-dem::State one_clump(const mesh::ClumpTemplate& t, const Quat& q, const Vec3& x, const Vec3& w_body) {
+dem::State one_clump(const geometry::ClumpTemplate& t, const Quat& q, const Vec3& x, const Vec3& w_body) {
   dem::State s;
   dem::add_clump(s, t, 1.0, 0, x, q, 2500, 0, Vec3::Zero(), q * w_body);
   return s;
@@ -102,7 +102,7 @@ dem::ModelSpec box_spec(double half_width, double height) {
 }
 
 // Clumps in a box, thrown in random directions at up to `speed` and spun.
-dem::State clump_pack(const mesh::ClumpTemplate& t, std::size_t count, double half_width, double height,
+dem::State clump_pack(const geometry::ClumpTemplate& t, std::size_t count, double half_width, double height,
                       std::uint64_t seed, double speed = 0) {
   dem::State s;
   dem::InsertRegion region;
@@ -148,7 +148,7 @@ TEST(FreeClump, KeepsItsAngularMomentumAndEnergy) {
 
 TEST(FreeClump, FlipsAboutItsIntermediateAxisOnly) {
   const OneThread one_thread;
-  const mesh::ClumpTemplate t = cross();
+  const geometry::ClumpTemplate t = cross();
   const Vec3 I = t.inertia_principal_per_density;
   ASSERT_LT(I[0], I[1]);
   ASSERT_LT(I[1], I[2]);
@@ -186,7 +186,7 @@ TEST(ClumpCollisions, ConserveMomentumAndAngularMomentum) {
   // force acts at one point on both, so the bodies' sums keep both momenta.
   dem::ModelSpec spec = free_space();
   spec.materials[0] = test::glass(0.6, 0.5);
-  const mesh::ClumpTemplate t = cross();
+  const geometry::ClumpTemplate t = cross();
   dem::State s;
   dem::add_clump(s, t, 1.0, 0, Vec3(-2.2e-3, 0.4e-3, 0), Quat(0.8, 0.2, 0.5, -0.1).normalized(), 2500, 0,
                  Vec3(0.3, 0, 0), Vec3(0, 0, 40));
@@ -261,7 +261,7 @@ TEST(ClumpRigidity, OverlappingMembersExertNoForceOnEachOther) {
 }
 
 TEST(ClumpInsertion, PlacesClumpsWithoutOverlapsReproducibly) {
-  const mesh::ClumpTemplate t = cross(0.3e-3);
+  const geometry::ClumpTemplate t = cross(0.3e-3);
   const dem::State a = clump_pack(t, 200, 6e-3, 14e-3, 3), b = clump_pack(t, 200, 6e-3, 14e-3, 3),
                    c = clump_pack(t, 200, 6e-3, 14e-3, 4);
   for (std::size_t i = 0; i < a.size(); ++i)
@@ -277,7 +277,7 @@ TEST(ClumpInsertion, PlacesClumpsWithoutOverlapsReproducibly) {
   EXPECT_LT(mean.norm(), 0.15);
   EXPECT_DOUBLE_EQ(a.bodies.mass[0], 2500 * t.mesh_volume_m3) << "the grain's mass, not the spheres'";
   dem::State none;
-  mesh::ClumpTemplate no_grain = t;
+  geometry::ClumpTemplate no_grain = t;
   no_grain.mesh_volume_m3 = 0;
   EXPECT_THROW(dem::add_clump(none, no_grain, 1.0, 0, Vec3::Zero(), Quat::Identity(), 2500, 0), diefill::InputError);
 }
@@ -358,7 +358,7 @@ TEST(Benchmark, DISABLED_SettledClumpPacks) {
   std::printf("kind,members,bodies,spheres,dt_s,settle_steps,ms_per_step,body_steps_per_s,sphere_steps_per_s,"
               "integration_ms,sums_ms,pair_ms,wall_ms,neighbour_ms\n");
   for (int kind = -1; kind < int(layouts.size()); ++kind) {
-    const mesh::ClumpTemplate t = template_of(kind < 0 ? layouts[0] : layouts[std::size_t(kind)], r);
+    const geometry::ClumpTemplate t = template_of(kind < 0 ? layouts[0] : layouts[std::size_t(kind)], r);
     const double bounding = dem::bounding_radius(t);
     // Bounding spheres at about a quarter of the box.
     const double height = double(count) * 4.0 / 3.0 * std::numbers::pi * std::pow(bounding, 3) / 0.25 /

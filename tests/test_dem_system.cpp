@@ -128,7 +128,7 @@ TEST(Reproducibility, ThreadCountDoesNotChangeTheState) {
 // friction and rolling resistance, give the same bits on 1 and 2 threads.
 TEST(Reproducibility, MeshWallsGiveTheSameStateOnAnyThreadCount) {
   const double r = 0.6e-3;
-  const mesh::TriMesh ring = mesh::bundled_die("ring");
+  const geometry::TriMesh ring = mesh::bundled_die("ring");
   const mesh::ToolMesh tool = mesh::tool_from_cavity(ring, mesh::table_around(ring, 3e-3), "ring");
   dem::ModelSpec spec = test::spec_with({test::glass(0.5, 0.4), test::rigid_wall(0.5, 0.3)}, Vec3(0, 0, -9.81));
   spec.materials[0].rolling_friction = spec.materials[1].rolling_friction = 0.1;
@@ -208,12 +208,12 @@ TEST(Reproducibility, ACheckpointOfAnotherVersionIsRefusedAsSuch) {
 }
 
 TEST(Insertion, FillsAClosedMeshWithoutOverlapsReproducibly) {
-  const mesh::TriMesh ring = mesh::bundled_die("ring");
+  const geometry::TriMesh ring = mesh::bundled_die("ring");
   mesh::SdfOptions o;
   o.voxel_m = 0.1e-3;
   o.exterior_band_m = 0.2e-3;
   o.interior_band_m = 0.5e-3;  // reaches the largest radius, 0.39 mm
-  const auto field = std::make_shared<const mesh::WallField>(mesh::build_sdf(ring, o).wall_field(ring));
+  const auto field = std::make_shared<const geometry::WallField>(mesh::build_sdf(ring, o).wall_field(ring));
   auto fill = [&](std::uint64_t seed) {
     dem::State s;
     dem::InsertRegion region;

@@ -24,9 +24,9 @@ namespace {
 
 // An L-shaped solid: a floor slab (top at z = 0) and a wall (face at x = 0): a 90° concave
 // corner along the y axis. United exactly by the repair stage.
-mesh::TriMesh corner_solid() {
-  const mesh::TriMesh floor = mesh::box_solid(Vec3(-10e-3, -10e-3, -5e-3), Vec3(10e-3, 10e-3, 0));
-  const mesh::TriMesh wall = mesh::box_solid(Vec3(-10e-3, -10e-3, -5e-3), Vec3(0, 10e-3, 10e-3));
+geometry::TriMesh corner_solid() {
+  const geometry::TriMesh floor = mesh::box_solid(Vec3(-10e-3, -10e-3, -5e-3), Vec3(10e-3, 10e-3, 0));
+  const geometry::TriMesh wall = mesh::box_solid(Vec3(-10e-3, -10e-3, -5e-3), Vec3(0, 10e-3, 10e-3));
   mesh::RepairOptions o;
   o.tolerance_m = 1e-6;
   return mesh::repair(test::joined(floor, wall), o, "corner").mesh;
@@ -73,7 +73,7 @@ TEST(MeshWall, ConvexRimGivesOneContinuousContact) {
   // table; the wall query's normal force must follow the exact-geometry force, without the
   // doubled force of counting the table and the bore separately.
   const double r = 0.5e-3, overlap = 0.01 * r;
-  const mesh::TriMesh ring = mesh::bundled_die("ring");
+  const geometry::TriMesh ring = mesh::bundled_die("ring");
   const mesh::ToolMesh tool = mesh::tool_from_cavity(ring, mesh::table_around(ring, 5e-3), "ring");
   dem::ModelSpec spec = test::spec_with({test::glass(), test::rigid_wall()});
   spec.meshes.push_back(dem::fixed_mesh_wall(test::wall_field_of(tool.mesh, r / 4), 1, "ring"));
@@ -119,7 +119,7 @@ TEST_P(PourIntoDie, TenThousandGrainsSettleWithoutLeaking) {
   spec.max_impact_speed = 0.6;
   spec.domain.lo = Vec3(-14e-3, -14e-3, -12e-3);
   spec.domain.hi = Vec3(14e-3, 14e-3, 20e-3);
-  spec.meshes.push_back(dem::fixed_mesh_wall(std::make_shared<const mesh::WallField>(die.sdf.wall_field(die.solid)), 1, name));
+  spec.meshes.push_back(dem::fixed_mesh_wall(std::make_shared<const geometry::WallField>(die.sdf.wall_field(die.solid)), 1, name));
   dem::State s;
   dem::InsertRegion region;
   // A column over the opening (the annulus of the ring): grains landing on the table or the
@@ -182,7 +182,7 @@ INSTANTIATE_TEST_SUITE_P(Dies, PourIntoDie, ::testing::Values("ring", "disc"));
 TEST(MeshWall, PlateThinnerThanAVoxelStillBlocks) {
   // A plate a quarter voxel thick, hit head-on at 1 m/s from above and from below.
   const double r = 0.5e-3, voxel = r / 4;
-  const mesh::TriMesh plate = mesh::box_solid(Vec3(-5e-3, -5e-3, -0.125 * voxel), Vec3(5e-3, 5e-3, 0.125 * voxel));
+  const geometry::TriMesh plate = mesh::box_solid(Vec3(-5e-3, -5e-3, -0.125 * voxel), Vec3(5e-3, 5e-3, 0.125 * voxel));
   for (double side : {1.0, -1.0}) {
     dem::ModelSpec spec = test::spec_with({test::glass(0.5), test::rigid_wall(0.5)});
     spec.meshes.push_back(dem::fixed_mesh_wall(test::wall_field_of(plate, voxel), 1, "plate"));
@@ -209,7 +209,7 @@ TEST(MeshWall, PlateThinnerThanAVoxelStillBlocks) {
 // at 300 m/s the grain passes the wall and leaves the domain, up to 100 m/s it bounces back.
 TEST(MeshWall, AGrainIsNeverPushedThroughAWallThinnerThanItsDiameter) {
   const double r = 0.5e-3, thickness = 0.3e-3;
-  const mesh::TriMesh wall = mesh::box_solid(Vec3(-5e-3, -5e-3, -0.5 * thickness), Vec3(5e-3, 5e-3, 0.5 * thickness));
+  const geometry::TriMesh wall = mesh::box_solid(Vec3(-5e-3, -5e-3, -0.5 * thickness), Vec3(5e-3, 5e-3, 0.5 * thickness));
   for (const double speed : {1.0, 5.0, 30.0, 300.0})
     for (const double side : {1.0, -1.0}) {
       dem::ModelSpec spec = test::spec_with({test::glass(0.5), test::rigid_wall(0.5)});

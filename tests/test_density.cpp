@@ -191,8 +191,8 @@ const mesh::PreparedDie& fine_ring() {
 const RingFill& ring_fill() {
   static const RingFill fill = [] {
     RingFill l{fine_ring(), {}, {}};
-    const mesh::WallField walls = l.die.sdf.wall_field(l.die.solid);
-    pipeline::DensitySettings s;
+    const geometry::WallField walls = l.die.sdf.wall_field(l.die.solid);
+    pipeline::DensityOptions s;
     s.voxel_m = 1e-3;
     l.lattice = pipeline::compute_density(ring_lattice(0.2e-3, Vec3(0.013e-3, 0.029e-3, 0.0)), l.die, walls, 7800, s, "lattice");
     const post::VoxelGrid& g = l.lattice.field.grid;
@@ -304,8 +304,8 @@ std::vector<post::Grain> ring_jittered_fill(double cell, double phi, std::uint64
 // cavity in the denominator the wall bins read far off.
 TEST(SmoothedField, KeepsAUniformFillFlatUpToTheWalls) {
   const double phi = 0.6;
-  const mesh::WallField walls = fine_ring().sdf.wall_field(fine_ring().solid);
-  pipeline::DensitySettings s;
+  const geometry::WallField walls = fine_ring().sdf.wall_field(fine_ring().solid);
+  pipeline::DensityOptions s;
   s.voxel_m = 2e-3;
   s.smoothed_width_m = 0.6e-3;
   const pipeline::DensityResult r = pipeline::compute_density(ring_jittered_fill(0.125e-3, phi, 7), fine_ring(), walls, 7800, s, "uniform fill");
@@ -338,8 +338,8 @@ TEST(CavityVolume, NothingBelowAThinTableCountsAsCavity) {
   mesh::DieOptions o = mesh::die_options_for_grains(0.88e-3, 0.44e-3);
   o.table = mesh::TableExtent{-15e-3, -15e-3, 15e-3, 15e-3, 2e-3};
   const mesh::PreparedDie die = mesh::prepare_die(test::source_dir() / "dies" / "ring.stl", o, std::nullopt);
-  const mesh::WallField walls = die.sdf.wall_field(die.solid);
-  pipeline::DensitySettings s;
+  const geometry::WallField walls = die.sdf.wall_field(die.solid);
+  pipeline::DensityOptions s;
   s.voxel_m = 3.2e-3;
   const pipeline::DensityResult r = pipeline::compute_density({{Vec3(7.5e-3, 0, -5e-3), 0.8e-3, 1.0}}, die, walls, 7800, s, "one grain");
   ASSERT_LT(r.field.grid.origin.z(), -12e-3) << "the grid must reach below the table for this test";

@@ -10,6 +10,7 @@
 #include "mesh/die.hpp"
 #include "mesh/orientation.hpp"
 #include "mesh/shapes.hpp"
+#include "mesh/tetmesh.hpp"
 #include "postprocess/compaction.hpp"
 #include "postprocess/fem.hpp"
 #include "postprocess/sphere_box.hpp"
@@ -19,13 +20,13 @@ namespace {
 
 using post::Vec3;
 
-mesh::TriMesh bundled(const std::string& name) {
-  return mesh::read_die_file(test::source_dir() / "dies" / (name + ".stl"), mesh::LengthUnit::mm).mesh;
+geometry::TriMesh bundled(const std::string& name) {
+  return mesh::read_die_file(test::source_dir() / "dies" / (name + ".stl"), geometry::LengthUnit::mm).mesh;
 }
 
-double mesh_volume(const mesh::TetMesh& m) {
+double mesh_volume(const geometry::TetMesh& m) {
   double v = 0;
-  for (const mesh::Tet& t : m.tets) v += mesh::tet_volume(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]], m.nodes[t[3]]);
+  for (const geometry::Tet& t : m.tets) v += geometry::tet_volume(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]], m.nodes[t[3]]);
   return v;
 }
 
@@ -41,8 +42,8 @@ double area_at_or_above(const Nodes& nodes, const Faces& faces, double z) {
 }
 
 // The ring meshed as the pipeline meshes it for 0.8 mm grains: elements of 1.6 mm.
-const mesh::TetMesh& ring_mesh() {
-  static const mesh::TetMesh m = mesh::tetrahedralise(bundled("ring"), {1.6e-3, 2e-5, 60}, "ring");
+const geometry::TetMesh& ring_mesh() {
+  static const geometry::TetMesh m = mesh::tetrahedralise(bundled("ring"), {1.6e-3, 2e-5, 60}, "ring");
   return m;
 }
 
@@ -53,13 +54,13 @@ double segment_distance(const Vec3& p, const Vec3& a, const Vec3& b) {
 }
 
 // A FemFill of the given element fractions on `m`.
-post::FemFill fill_of(const mesh::TetMesh& m, const std::function<double(const Vec3&)>& fraction) {
+post::FemFill fill_of(const geometry::TetMesh& m, const std::function<double(const Vec3&)>& fraction) {
   post::FemFill f;
   f.mesh = m;
   f.material_density = 7800;
-  for (const mesh::Tet& t : m.tets) {
+  for (const geometry::Tet& t : m.tets) {
     const Vec3 centroid = 0.25 * (m.nodes[t[0]] + m.nodes[t[1]] + m.nodes[t[2]] + m.nodes[t[3]]);
-    f.element_volume.push_back(mesh::tet_volume(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]], m.nodes[t[3]]));
+    f.element_volume.push_back(geometry::tet_volume(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]], m.nodes[t[3]]));
     f.element_fraction.push_back(fraction(centroid));
   }
   f.node_fraction = post::average_to_nodes(f.mesh, f.element_fraction, f.element_volume);
@@ -75,10 +76,10 @@ void expect_clean_log(const std::string& log) {
 }  // namespace
 
 TEST(TetMesh, RingIsMeshedWithItsVolumeAndItsRimsOnMeshEdges) {
-  const mesh::TriMesh ring = bundled("ring");
-  const mesh::TetMesh& m = ring_mesh();
-  const mesh::TetQuality q = mesh::tet_quality(m);
-  const double volume = mesh_volume(m), expected = mesh::signed_volume(ring);
+  const geometry::TriMesh ring = bundled("ring");
+  const geometry::TetMesh& m = ring_mesh();
+  const geometry::TetQuality q = geometry::tet_quality(m);
+  const double volume = mesh_volume(m), expected = geometry::signed_volume(ring);
   std::printf("%zu nodes, %zu elements; volume %.6g of %.6g mm³; dihedral %.1f–%.1f°, radius ratio ≥ %.3f (mean %.3f)\n",
               m.nodes.size(), m.tets.size(), volume * 1e9, expected * 1e9, q.min_dihedral_deg, q.max_dihedral_deg,
               q.min_radius_ratio, q.mean_radius_ratio);
@@ -122,7 +123,7 @@ TEST(TetMesh, RingIsMeshedWithItsVolumeAndItsRimsOnMeshEdges) {
 }
 
 TEST(TetMesh, IsTheSameMeshTwice) {
-  const mesh::TetMesh again = mesh::tetrahedralise(bundled("ring"), {1.6e-3, 2e-5, 60}, "ring");
+  const geometry::TetMesh again = mesh::tetrahedralise(bundled("ring"), {1.6e-3, 2e-5, 60}, "ring");
   ASSERT_EQ(again.tets, ring_mesh().tets);
   ASSERT_EQ(again.nodes, ring_mesh().nodes);
 }
@@ -132,21 +133,21 @@ TEST(TetMesh, IsTheSameMeshTwice) {
 // elements of either (Mesh_3 keeps the protecting balls of the two bodies' edges apart). The
 // joined mesh is exactly the two cubes' own meshes, nodes and elements in that order.
 TEST(TetMesh, SeparateBodiesAreMeshedEachAlone) {
-  const mesh::TriMesh a = mesh::box_solid(Vec3(0, 0, 0), Vec3(10e-3, 10e-3, 10e-3));
-  const mesh::TriMesh b = mesh::box_solid(Vec3(10.1e-3, 0, 0), Vec3(20.1e-3, 10e-3, 10e-3));
-  mesh::TriMesh both = a;
-  for (mesh::Triangle t : b.triangles) {
+  const geometry::TriMesh a = mesh::box_solid(Vec3(0, 0, 0), Vec3(10e-3, 10e-3, 10e-3));
+  const geometry::TriMesh b = mesh::box_solid(Vec3(10.1e-3, 0, 0), Vec3(20.1e-3, 10e-3, 10e-3));
+  geometry::TriMesh both = a;
+  for (geometry::Triangle t : b.triangles) {
     for (int& v : t) v += int(a.vertices.size());
     both.triangles.push_back(t);
   }
   both.vertices.insert(both.vertices.end(), b.vertices.begin(), b.vertices.end());
-  const std::vector<mesh::TriMesh> bodies = mesh::separate_bodies(both);
+  const std::vector<geometry::TriMesh> bodies = geometry::separate_bodies(both);
   ASSERT_EQ(bodies.size(), 2u);
   EXPECT_EQ(bodies[1].triangles.size(), b.triangles.size());
-  EXPECT_NEAR(mesh::signed_volume(bodies[1]), 1e-6, 1e-15);
+  EXPECT_NEAR(geometry::signed_volume(bodies[1]), 1e-6, 1e-15);
   const mesh::TetMeshOptions o{4e-3, 2e-5, 60};
-  const mesh::TetMesh alone_a = mesh::tetrahedralise(bodies[0], o, "a"), alone_b = mesh::tetrahedralise(bodies[1], o, "b");
-  const mesh::TetMesh joined = mesh::tetrahedralise(both, o, "both");
+  const geometry::TetMesh alone_a = mesh::tetrahedralise(bodies[0], o, "a"), alone_b = mesh::tetrahedralise(bodies[1], o, "b");
+  const geometry::TetMesh joined = mesh::tetrahedralise(both, o, "both");
   ASSERT_EQ(joined.tets.size(), alone_a.tets.size() + alone_b.tets.size());
   ASSERT_EQ(joined.nodes.size(), alone_a.nodes.size() + alone_b.nodes.size());
   for (std::size_t i = 0; i < alone_b.nodes.size(); ++i)
@@ -160,7 +161,7 @@ TEST(TetMesh, SeparateBodiesAreMeshedEachAlone) {
 // Mesh_3 protects the chamfer's edges and puts nodes on its three corners.
 TEST(TetMesh, EdgesShorterThanTheFacetDistanceShrinkNoElement) {
   const double d = 1e-6, a = 10e-3;
-  mesh::TriMesh cube;
+  geometry::TriMesh cube;
   cube.vertices = {Vec3(0, 0, 0), Vec3(a, 0, 0), Vec3(a, a, 0), Vec3(0, a, 0), Vec3(0, 0, a), Vec3(a, 0, a),
                    Vec3(a - d, a, a), Vec3(a, a - d, a), Vec3(a, a, a - d), Vec3(0, a, a)};
   enum { O, X, XY, Y, Z, XZ, Gx, Gy, Gz, YZ };
@@ -169,10 +170,10 @@ TEST(TetMesh, EdgesShorterThanTheFacetDistanceShrinkNoElement) {
                                                {X, XY, Gz, Gy, XZ}, {Y, YZ, Gx, Gz, XY}, {Gx, Gy, Gz}};
   for (const auto& f : faces)
     for (std::size_t k = 1; k + 1 < f.size(); ++k) cube.triangles.push_back({f[0], f[k], f[k + 1]});
-  ASSERT_NEAR(mesh::signed_volume(cube), a * a * a, 1e-15) << "closed and outward";
-  const mesh::TetMesh m = mesh::tetrahedralise(cube, {4e-3, 2e-5, 60}, "chamfer");
+  ASSERT_NEAR(geometry::signed_volume(cube), a * a * a, 1e-15) << "closed and outward";
+  const geometry::TetMesh m = mesh::tetrahedralise(cube, {4e-3, 2e-5, 60}, "chamfer");
   double shortest = 1;
-  for (const mesh::Tet& t : m.tets)
+  for (const geometry::Tet& t : m.tets)
     for (int i = 0; i < 4; ++i)
       for (int j = i + 1; j < 4; ++j) shortest = std::min(shortest, (m.nodes[t[i]] - m.nodes[t[j]]).norm());
   EXPECT_GT(shortest, 1e-4);
@@ -183,7 +184,7 @@ TEST(TetMesh, EdgesShorterThanTheFacetDistanceShrinkNoElement) {
 // pipeline"): the largest grain radius, the SDF voxel and the element size of that run.
 struct SharedCavity {
   const char* file;
-  mesh::LengthUnit unit;
+  geometry::LengthUnit unit;
   double grain_radius_m, voxel_m, element_m;
   const char* up_in_file = nullptr;  // the way its opening faces in the file, where that is what its repair found
 };
@@ -210,11 +211,11 @@ TEST_P(SharedCavityMesh, HasNoElementCalculiXRefuses) {
     EXPECT_GE(mesh::opening_area(die.cavity, mesh::Up{2, 1}), 0.5 * mesh::shadow_area(die.cavity, 2));
   }
   const double facet_distance = c.element_m / 200;
-  const mesh::TetMesh m = mesh::tetrahedralise(die.cavity, {c.element_m, facet_distance, 60}, c.file);
+  const geometry::TetMesh m = mesh::tetrahedralise(die.cavity, {c.element_m, facet_distance, 60}, c.file);
   std::size_t refused = 0;
   double smallest = 1;
-  for (const mesh::Tet& t : m.tets) {
-    const double jacobian = 6 * mesh::tet_volume(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]], m.nodes[t[3]]);
+  for (const geometry::Tet& t : m.tets) {
+    const double jacobian = 6 * geometry::tet_volume(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]], m.nodes[t[3]]);
     refused += jacobian < 1e-20;
     smallest = std::min(smallest, jacobian);
   }
@@ -235,8 +236,8 @@ TEST_P(SharedCavityMesh, HasNoElementCalculiXRefuses) {
 
 INSTANTIATE_TEST_SUITE_P(
     Pipeline, SharedCavityMesh,
-    ::testing::Values(SharedCavity{"large_turbineblade_vtk_199k.ply", mesh::LengthUnit::mm, 0.453e-3, 0.25 * 0.453e-3, 1.8129e-3},
-                      SharedCavity{"flanged_ring_trimesh_idler_riser.stl", mesh::LengthUnit::in, 0.9125e-3, 0.365e-3, 3.3179e-3, "-z"}));
+    ::testing::Values(SharedCavity{"large_turbineblade_vtk_199k.ply", geometry::LengthUnit::mm, 0.453e-3, 0.25 * 0.453e-3, 1.8129e-3},
+                      SharedCavity{"flanged_ring_trimesh_idler_riser.stl", geometry::LengthUnit::in, 0.9125e-3, 0.365e-3, 3.3179e-3, "-z"}));
 
 // Mesh_3 places a flat face's nodes by its constructions: in a pipeline run on the turbine blade
 // one table node lay 1.85 nm above the rest, and the table, taken as the highest node's plane,
@@ -244,7 +245,7 @@ INSTANTIATE_TEST_SUITE_P(
 // node raised that much keeps every face it had, and they cover the ring's top (to the corners
 // the mesh's rim cuts off the file's 104-gons, less than 0.1 %).
 TEST(FemFiles, TheTableKeepsItsFacesWhenANodeLiesNanometresAboveIt) {
-  mesh::TetMesh m = ring_mesh();
+  geometry::TetMesh m = ring_mesh();
   double top = -1;
   for (const Vec3& p : m.nodes) top = std::max(top, p.z());
   const std::size_t faces = post::boundary_sets(m, top).table.size();
@@ -253,7 +254,7 @@ TEST(FemFiles, TheTableKeepsItsFacesWhenANodeLiesNanometresAboveIt) {
   on_top->z() += 1.85e-9;
   const post::BoundarySets raised = post::boundary_sets(m, top + 1.85e-9);
   EXPECT_EQ(raised.table.size(), faces);
-  const mesh::TriMesh ring = bundled("ring");
+  const geometry::TriMesh ring = bundled("ring");
   const double opening = area_at_or_above(ring.vertices, ring.triangles, top);
   EXPECT_NEAR(area_at_or_above(m.nodes, raised.table, -1.0), opening, 1e-3 * opening);
 }
@@ -328,7 +329,7 @@ TEST(FemFill, ElementsReadTheLatticeTheyHoldWallLayersIncluded) {
   }
   const mesh::PreparedDie die = mesh::prepare_die(test::source_dir() / "dies" / "ring.stl",
                                                   mesh::die_options_for_grains(0.4e-3, 0.2e-3), std::nullopt);
-  const mesh::WallField walls = die.sdf.wall_field(die.solid);
+  const geometry::WallField walls = die.sdf.wall_field(die.solid);
   const post::CavityShape cavity{[&](const Vec3& p) { return walls.signed_distance(p); }, die.after.bbox.lo,
                                  Vec3(die.after.bbox.hi.x(), die.after.bbox.hi.y(), die.table_z)};
   const post::FemFill f = post::fill_elements(ring_mesh(), grains, cavity, 0.2e-3, 7800);
@@ -345,7 +346,7 @@ TEST(FemFill, ElementsReadTheLatticeTheyHoldWallLayersIncluded) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   constexpr int samples = 2000;
   for (std::size_t e = 0; e < f.mesh.tets.size(); ++e) {
-    const mesh::Tet& t = f.mesh.tets[e];
+    const geometry::Tet& t = f.mesh.tets[e];
     double top = -1, radius_lo = 1, radius_hi = 0, bottom = 0;
     for (int n : t) {
       const Vec3& p = f.mesh.nodes[n];
@@ -392,8 +393,8 @@ TEST(Compaction, AUniformDiscGivesTheAnalyticPunchForce) {
   // Uniaxial strain of a uniform fill: σ_zz = M ε everywhere, so the punch force is M ε A, with
   // A the disc's cross-section (its volume over its depth); linear and quadratic elements.
   test::TempDir dir;
-  const mesh::TriMesh disc = bundled("disc");
-  const double depth = 10e-3, area = mesh::signed_volume(disc) / depth, phi = 0.55;
+  const geometry::TriMesh disc = bundled("disc");
+  const double depth = 10e-3, area = geometry::signed_volume(disc) / depth, phi = 0.55;
   const post::FemFill f = fill_of(mesh::tetrahedralise(disc, {2e-3, 2e-5, 60}, "disc"), [&](const Vec3&) { return phi; });
   const post::CompactionSettings s;
   const double expected = post::constrained_modulus(post::tabulated_modulus(s, phi), s.poisson_ratio) * s.axial_strain * area;
@@ -413,7 +414,7 @@ TEST(Compaction, TwoDensityColumnStrainsAsTheInverseOfItsModuli) {
   // than an element from the middle (the nodes' averaged fraction blends the layers there).
   test::TempDir dir;
   const double h = 2e-3, lo_phi = 0.45, hi_phi = 0.65;
-  const mesh::TetMesh m = mesh::tetrahedralise(mesh::box_solid(Vec3(0, 0, -20e-3), Vec3(10e-3, 10e-3, 0)), {h, 2e-5, 60}, "column");
+  const geometry::TetMesh m = mesh::tetrahedralise(mesh::box_solid(Vec3(0, 0, -20e-3), Vec3(10e-3, 10e-3, 0)), {h, 2e-5, 60}, "column");
   const post::FemFill f = fill_of(m, [&](const Vec3& c) { return c.z() < -10e-3 ? lo_phi : hi_phi; });
   post::write_fem(f, false, "two-density column", dir.path());
   const post::CompactionSettings s;
@@ -437,7 +438,7 @@ TEST(Compaction, TwoDensityColumnStrainsAsTheInverseOfItsModuli) {
 
 TEST(FemFiles, AreReadByMeshioWithTheirArrays) {
   test::TempDir dir;
-  const mesh::TetMesh& m = ring_mesh();
+  const geometry::TetMesh& m = ring_mesh();
   const post::FemFill f = fill_of(m, [](const Vec3& c) { return 0.5 + 10 * c.x(); });
   for (const bool quadratic : {false, true}) {
     post::write_fem(f, quadratic, "ring", dir.path());

@@ -76,9 +76,9 @@ TEST(TetBoxOverlap, AVoxelGridPartitionsATetrahedron) {
 TEST(FemFill, SharesEachGrainAmongTheElementsItOverlaps) {
   // One grain in the middle of a cube split in six: the elements together hold exactly its
   // volume, each its exact part (the six are alike under the cube's symmetry: a sixth each).
-  mesh::TetMesh m;
+  geometry::TetMesh m;
   for (const Corners& t : cube_tets()) {
-    mesh::Tet tet;
+    geometry::Tet tet;
     for (int k = 0; k < 4; ++k) {
       tet[std::size_t(k)] = int(m.nodes.size());
       m.nodes.push_back(1e-3 * t[std::size_t(k)]);
@@ -104,10 +104,10 @@ TEST(FemFill, SharesEachGrainAmongTheElementsItOverlaps) {
 // The report's inverted_elements counts elements as handed over: one turned inside out (two
 // corners swapped) is counted, its twin in C3D4's order is not.
 TEST(TetQuality, CountsAnElementTurnedInsideOut) {
-  mesh::TetMesh m;
+  geometry::TetMesh m;
   m.nodes = {Vec3(0, 0, 0), Vec3(1e-3, 0, 0), Vec3(0, 1e-3, 0), Vec3(0, 0, 1e-3), Vec3(0, 0, -1e-3)};
   m.tets = {{0, 1, 2, 3}, {0, 1, 2, 4}};
-  EXPECT_EQ(mesh::tet_quality(m).inverted, 1u);
+  EXPECT_EQ(geometry::tet_quality(m).inverted, 1u);
   m.tets[1] = {0, 2, 1, 4};
-  EXPECT_EQ(mesh::tet_quality(m).inverted, 0u);
+  EXPECT_EQ(geometry::tet_quality(m).inverted, 0u);
 }

@@ -16,17 +16,17 @@
 #include "meshes.hpp"
 #include "support.hpp"
 
-using mesh::Vec3;
+using geometry::Vec3;
 
 namespace {
 
 // A 10 mm cube cavity with a 4 mm cube standing in it: small, but with the features repair meets.
-mesh::TriMesh small_die() {
+geometry::TriMesh small_die() {
   return test::joined(mesh::box_solid(Vec3(0, 0, -10e-3), Vec3(10e-3, 10e-3, 0)),
                       test::reversed(mesh::box_solid(Vec3(3e-3, 3e-3, -10e-3), Vec3(7e-3, 7e-3, -6e-3))));
 }
 
-mesh::TriMesh mutated_mesh(mesh::TriMesh m, std::mt19937_64& random) {
+geometry::TriMesh mutated_mesh(geometry::TriMesh m, std::mt19937_64& random) {
   const double values[] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(), 1e30, -1e-30, 0, 5e-3};
   for (int k = 0; k < 1 + int(random() % 4); ++k) {
     switch (random() % 5) {
@@ -66,15 +66,15 @@ class MeshFuzz : public ::testing::TestWithParam<int> {};
 
 TEST_P(MeshFuzz, MutatedDiesPrepareOrAreRefusedClearly) {
   test::TempDir dir;
-  const mesh::TriMesh die = small_die();
-  mesh::write_stl(die, dir / "clean.stl", mesh::LengthUnit::mm, "fuzz");
+  const geometry::TriMesh die = small_die();
+  mesh::write_stl(die, dir / "clean.stl", geometry::LengthUnit::mm, "fuzz");
   const std::string clean = test::read_text(dir / "clean.stl");
   mesh::DieOptions options = mesh::die_options_for_grains(1e-3, 0.5e-3, 0.5e-3);
   int prepared = 0, refused = 0;
   for (int n = GetParam() * dies_per_block; n < (GetParam() + 1) * dies_per_block; ++n) {
     std::mt19937_64 random(16 + std::uint64_t(n));
     const std::filesystem::path file = dir / "die.stl";
-    if (n % 2 == 0) mesh::write_stl(mutated_mesh(die, random), file, mesh::LengthUnit::mm, "fuzz");
+    if (n % 2 == 0) mesh::write_stl(mutated_mesh(die, random), file, geometry::LengthUnit::mm, "fuzz");
     else test::write_text(file, mutated_bytes(clean, random));
     options.role = n % 3 == 0 ? mesh::WallRole::tool : mesh::WallRole::cavity;
     try {

@@ -13,7 +13,7 @@
 #include "meshes.hpp"
 #include "support.hpp"
 
-using mesh::Vec3;
+using geometry::Vec3;
 
 namespace {
 
@@ -23,8 +23,8 @@ double polygon_annulus_volume(double ro, double ri, double depth, int n) {
 }
 
 // The octahedron with vertices ±a x, ±b y, ±c z [m], outward: no flat face anywhere.
-mesh::TriMesh octahedron_of(double a, double b, double c) {
-  mesh::TriMesh octahedron;
+geometry::TriMesh octahedron_of(double a, double b, double c) {
+  geometry::TriMesh octahedron;
   for (const double half : {a, b, c})
     for (int s : {1, -1}) octahedron.vertices.push_back(s * half * Vec3::Unit(int(octahedron.vertices.size()) / 2));
   octahedron.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
@@ -35,10 +35,10 @@ mesh::TriMesh octahedron_of(double a, double b, double c) {
 
 TEST(BundledDies, MeetChordToleranceAndAnalyticVolume) {
   for (const auto& [name, inner] : {std::pair{"ring", 10e-3}, std::pair{"disc", 0.0}}) {
-    const mesh::TriMesh die = mesh::bundled_die(name);
+    const geometry::TriMesh die = mesh::bundled_die(name);
     const int n = mesh::circle_segments(10e-3, 5e-6);
     EXPECT_LT(mesh::chord_error(10e-3, n), 0.01e-3) << name;
-    EXPECT_NEAR(mesh::signed_volume(die), polygon_annulus_volume(10e-3, inner / 2, 10e-3, n), 1e-15)
+    EXPECT_NEAR(geometry::signed_volume(die), polygon_annulus_volume(10e-3, inner / 2, 10e-3, n), 1e-15)
         << name;
     // Chord error measured on the mesh: every edge midpoint at the rim lies within 0.01 mm of
     // the circle it approximates.
@@ -53,7 +53,7 @@ TEST(BundledDies, MeetChordToleranceAndAnalyticVolume) {
       }
     EXPECT_GT(worst, 0.0) << name;
     EXPECT_LT(worst, 0.01e-3) << name;
-    const mesh::Box box = mesh::bounding_box(die);
+    const geometry::Box box = geometry::bounding_box(die);
     EXPECT_DOUBLE_EQ(box.hi.z(), 0.0) << name << ": top face on the die table";
     EXPECT_DOUBLE_EQ(box.lo.z(), -10e-3) << name;
   }
@@ -64,8 +64,8 @@ TEST(BundledDies, MeetChordToleranceAndAnalyticVolume) {
 // (negative, or short of it, if a face were flipped or missing).
 TEST(RevolvedSolid, IsTheClosedPolygonalAnnulus) {
   const int n = 32;
-  const mesh::TriMesh tube = mesh::revolved_solid({{3e-3, 0}, {5e-3, 0}, {5e-3, 4e-3}, {3e-3, 4e-3}}, n);
-  EXPECT_NEAR(mesh::signed_volume(tube), polygon_annulus_volume(5e-3, 3e-3, 4e-3, n), 1e-15);
+  const geometry::TriMesh tube = mesh::revolved_solid({{3e-3, 0}, {5e-3, 0}, {5e-3, 4e-3}, {3e-3, 4e-3}}, n);
+  EXPECT_NEAR(geometry::signed_volume(tube), polygon_annulus_volume(5e-3, 3e-3, 4e-3, n), 1e-15);
   EXPECT_TRUE(mesh::inspect(tube).closed);
 }
 
@@ -73,7 +73,7 @@ TEST(BundledDies, FilesInDiesAreTheGeneratedOnes) {
   test::TempDir dir;
   for (const std::string& name : mesh::bundled_die_names()) {
     const auto regenerated = dir / (name + ".stl");
-    mesh::write_stl(mesh::bundled_die(name), regenerated, mesh::LengthUnit::mm,
+    mesh::write_stl(mesh::bundled_die(name), regenerated, geometry::LengthUnit::mm,
                     "diefill " + name + " cavity, mm");
     EXPECT_EQ(test::read_text(regenerated), test::read_text(test::source_dir() / "dies" / (name + ".stl")))
         << "dies/" << name << ".stl differs from `diefill die " << name << "`";
@@ -84,22 +84,22 @@ TEST(BundledDies, FilesInDiesAreTheGeneratedOnes) {
 // depth (the mesh closes on its outlines), and the core's area is the ISO 14 profile's within the
 // chords cut every 3°: a 6 x 11 x 14 spline with 3 mm keys.
 TEST(BundledDies, SplinedBoreHasTheProfilesArea) {
-  const mesh::TriMesh die = mesh::bundled_die("spline");
+  const geometry::TriMesh die = mesh::bundled_die("spline");
   const double depth = 8e-3, r = 5.5e-3, big_r = 7e-3, half = 1.5e-3;
   // ∫ sqrt(a² - y²) dy over |y| < h.
   const auto band = [](double a, double h) { return h * std::sqrt(a * a - h * h) + a * a * std::asin(h / a); };
   const double core = std::numbers::pi * r * r + 6 * (band(big_r, half) - band(r, half));  // the minor circle and six keys
   const double hub = std::numbers::pi * 12e-3 * 12e-3;
-  EXPECT_NEAR(mesh::signed_volume(die), (hub - core) * depth, 2e-3 * (hub - core) * depth);
-  const mesh::Box box = mesh::bounding_box(die);
+  EXPECT_NEAR(geometry::signed_volume(die), (hub - core) * depth, 2e-3 * (hub - core) * depth);
+  const geometry::Box box = geometry::bounding_box(die);
   EXPECT_DOUBLE_EQ(box.hi.z(), 0.0);
   EXPECT_NEAR(box.size().x(), 24e-3, 2 * 5e-6);  // the outer circle's chord error, at most 5 µm each side
 }
 
 // The disc with a conical floor (its centre 1 mm lower): a cavity with one flat end only, its
 // opening, where an extruded part has two alike.
-mesh::TriMesh disc_with_one_flat_end() {
-  mesh::TriMesh die = mesh::bundled_die("disc");
+geometry::TriMesh disc_with_one_flat_end() {
+  geometry::TriMesh die = mesh::bundled_die("disc");
   for (Vec3& v : die.vertices)
     if (v.head<2>().norm() < 1e-12 && v.z() < 0) v.z() -= 1e-3;
   return die;
@@ -110,25 +110,25 @@ mesh::TriMesh disc_with_one_flat_end() {
 // its volume's sign. An extruded part's two alike ends are told apart only by the flag: the
 // axis is found, the sign is +. A mesh with no flat face at any extreme is refused by name.
 TEST(Orientation, FindsTheOpeningWhicheverWayTheDieFaces) {
-  const mesh::TriMesh ring = disc_with_one_flat_end();
+  const geometry::TriMesh ring = disc_with_one_flat_end();
   for (int axis = 0; axis < 3; ++axis)
     for (int sign : {1, -1}) {
       const mesh::Up up{axis, sign};
-      mesh::TriMesh lying = ring;
+      geometry::TriMesh lying = ring;
       for (int k = 0; k < 3; ++k) mesh::turn_up(lying, up);  // a quarter or half turn's inverse
       EXPECT_EQ(mesh::find_opening(lying, "ring"), up) << mesh::up_name(up);
       EXPECT_NEAR(mesh::opening_area(lying, up), 0.25 * std::numbers::pi * 20e-3 * 20e-3, 1e-3 * 3.2e-4);
       mesh::turn_up(lying, up);
       EXPECT_EQ(lying.vertices, ring.vertices) << mesh::up_name(up);
-      EXPECT_DOUBLE_EQ(mesh::signed_volume(lying), mesh::signed_volume(ring));
-      mesh::TriMesh extruded = mesh::bundled_die("ring");
+      EXPECT_DOUBLE_EQ(geometry::signed_volume(lying), geometry::signed_volume(ring));
+      geometry::TriMesh extruded = mesh::bundled_die("ring");
       for (int k = 0; k < 3; ++k) mesh::turn_up(extruded, up);
       EXPECT_EQ(mesh::find_opening(extruded, "ring"), (mesh::Up{axis, 1}));
     }
   // Every generated die (the 1.2 mm slot's opening is its whole outline, its sides 6.7 times its area).
   for (const std::string& name : mesh::generated_die_names())
     EXPECT_EQ(mesh::find_opening(mesh::bundled_die(name), name), mesh::Up{}) << name;
-  const mesh::TriMesh octahedron = octahedron_of(1e-2, 1e-2, 1e-2);
+  const geometry::TriMesh octahedron = octahedron_of(1e-2, 1e-2, 1e-2);
   try {
     mesh::find_opening(octahedron, "octahedron.stl");
     ADD_FAILURE() << "an octahedron has no opening";
@@ -144,10 +144,10 @@ TEST(Orientation, FindsTheOpeningWhicheverWayTheDieFaces) {
 // under a boss (Ø4 mm, 3 mm high: its top is 4 % of the shadow along z) is filled through the
 // plate's face, below; the shadow along z is the plate's disc.
 TEST(Orientation, ABossIsNoOpening) {
-  mesh::TriMesh flange = mesh::ring_cavity(20e-3, 0, 2e-3, 1e-6);
-  mesh::TriMesh boss = mesh::ring_cavity(4e-3, 0, 3e-3, 1e-6);
+  geometry::TriMesh flange = mesh::ring_cavity(20e-3, 0, 2e-3, 1e-6);
+  geometry::TriMesh boss = mesh::ring_cavity(4e-3, 0, 3e-3, 1e-6);
   for (Vec3& v : boss.vertices) v.z() += 3e-3;
-  const mesh::TriMesh part = test::joined(flange, boss);
+  const geometry::TriMesh part = test::joined(flange, boss);
   EXPECT_NEAR(mesh::shadow_area(part, 2), std::numbers::pi * 1e-4, 0.01 * std::numbers::pi * 1e-4);
   EXPECT_EQ(mesh::find_opening(part, "flange"), (mesh::Up{2, -1}));
 }
@@ -156,8 +156,8 @@ TEST(Orientation, ABossIsNoOpening) {
 // half-diagonals a and c has area 2ac(1 - |t|/b)², exactly, whatever its triangles.
 TEST(Parting, SectionAreaOfAnOctahedronIsItsRhombus) {
   const double a = 10e-3, b = 6e-3, c = 20e-3;
-  const mesh::TriMesh octahedron = octahedron_of(a, b, c);
-  ASSERT_GT(mesh::signed_volume(octahedron), 0);
+  const geometry::TriMesh octahedron = octahedron_of(a, b, c);
+  ASSERT_GT(geometry::signed_volume(octahedron), 0);
   for (const double t : {-19e-3, -7.5e-3, 0.0, 3e-3, 19.9e-3}) {
     const double rhombus = 2 * a * b * std::pow(1 - std::abs(t) / c, 2);
     EXPECT_NEAR(mesh::section_area(octahedron, t), rhombus, 1e-12 * a * b) << t;
@@ -176,11 +176,11 @@ TEST(Parting, SectionAreaOfAnOctahedronIsItsRhombus) {
 // equator, its opening the rhombus there. die.parting = "opening" refuses it by name instead.
 TEST(Parting, APartWithNoFlatFaceIsCutAtItsWidestSection) {
   const double a = 10e-3, b = 6e-3, c = 20e-3;
-  const mesh::TriMesh octahedron = octahedron_of(a, b, c);
+  const geometry::TriMesh octahedron = octahedron_of(a, b, c);
   test::TempDir dir;
-  mesh::write_stl(octahedron, dir / "octahedron.stl", mesh::LengthUnit::mm, "octahedron");
+  mesh::write_stl(octahedron, dir / "octahedron.stl", geometry::LengthUnit::mm, "octahedron");
   const mesh::DieFile file =
-      mesh::read_die_file(dir / "octahedron.stl", mesh::LengthUnit::mm, std::nullopt, mesh::Parting::automatic);
+      mesh::read_die_file(dir / "octahedron.stl", geometry::LengthUnit::mm, std::nullopt, mesh::Parting::automatic);
   EXPECT_EQ(file.up, (mesh::Up{1, 1}));
   EXPECT_TRUE(file.up_found);
   ASSERT_TRUE(file.parting_z.has_value());
@@ -189,16 +189,16 @@ TEST(Parting, APartWithNoFlatFaceIsCutAtItsWidestSection) {
   mesh::DieOptions options = mesh::die_options_for_grains(1e-3, 0.5e-3, 0.5e-3);
   const mesh::PreparedDie die = mesh::prepare_die(file, options, std::nullopt);
   const double below = 2 * a * c * b / 3 * (2 - std::pow(1 - h / b, 3));
-  EXPECT_NEAR(mesh::signed_volume(die.cavity), below, 1e-9 * below);
+  EXPECT_NEAR(geometry::signed_volume(die.cavity), below, 1e-9 * below);
   EXPECT_TRUE(die.after.closed);
   EXPECT_EQ(die.after.self_intersections, 0u);
-  EXPECT_NEAR(mesh::bounding_box(die.cavity).hi.z(), h, 1e-12);
-  EXPECT_DOUBLE_EQ(die.table_z, mesh::bounding_box(die.cavity).hi.z());
+  EXPECT_NEAR(geometry::bounding_box(die.cavity).hi.z(), h, 1e-12);
+  EXPECT_DOUBLE_EQ(die.table_z, geometry::bounding_box(die.cavity).hi.z());
   EXPECT_NEAR(mesh::opening_area(die.cavity, mesh::Up{}), 2 * a * c * std::pow(1 - h / b, 2), 1e-9 * a * c);
   ASSERT_EQ(die.actions.size(), 1u);
   EXPECT_NE(die.actions.front().find("widest section"), std::string::npos) << die.actions.front();
   try {
-    mesh::read_die_file(dir / "octahedron.stl", mesh::LengthUnit::mm, std::nullopt, mesh::Parting::opening);
+    mesh::read_die_file(dir / "octahedron.stl", geometry::LengthUnit::mm, std::nullopt, mesh::Parting::opening);
     ADD_FAILURE() << "an octahedron has no flat opening";
   } catch (const diefill::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("octahedron.stl"), std::string::npos) << e.what();
@@ -212,19 +212,19 @@ TEST(Parting, APartWithNoFlatFaceIsCutAtItsWidestSection) {
 // the same triangles in the same places, up to the file's single precision.
 TEST(Orientation, ADieFileOnItsSideIsReadFacingUp) {
   test::TempDir dir;
-  const mesh::TriMesh ring = disc_with_one_flat_end();
-  mesh::TriMesh lying = ring;
+  const geometry::TriMesh ring = disc_with_one_flat_end();
+  geometry::TriMesh lying = ring;
   for (int k = 0; k < 3; ++k) mesh::turn_up(lying, mesh::Up{0, -1});
-  mesh::write_stl(lying, dir / "lying.stl", mesh::LengthUnit::mm, "ring on its side");
-  mesh::write_stl(ring, dir / "upright.stl", mesh::LengthUnit::mm, "ring");
-  const mesh::DieFile found = mesh::read_die_file(dir / "lying.stl", mesh::LengthUnit::mm, std::nullopt);
-  const mesh::DieFile upright = mesh::read_die_file(dir / "upright.stl", mesh::LengthUnit::mm, std::nullopt);
+  mesh::write_stl(lying, dir / "lying.stl", geometry::LengthUnit::mm, "ring on its side");
+  mesh::write_stl(ring, dir / "upright.stl", geometry::LengthUnit::mm, "ring");
+  const mesh::DieFile found = mesh::read_die_file(dir / "lying.stl", geometry::LengthUnit::mm, std::nullopt);
+  const mesh::DieFile upright = mesh::read_die_file(dir / "upright.stl", geometry::LengthUnit::mm, std::nullopt);
   EXPECT_TRUE(found.up_found);
   EXPECT_EQ(found.up, (mesh::Up{0, -1}));
   EXPECT_EQ(upright.up, mesh::Up{});
   ASSERT_EQ(found.mesh.triangles.size(), upright.mesh.triangles.size());
-  EXPECT_NEAR(mesh::signed_volume(found.mesh), mesh::signed_volume(upright.mesh), 1e-6 * mesh::signed_volume(upright.mesh));
-  const mesh::Box a = mesh::bounding_box(found.mesh), b = mesh::bounding_box(upright.mesh);
+  EXPECT_NEAR(geometry::signed_volume(found.mesh), geometry::signed_volume(upright.mesh), 1e-6 * geometry::signed_volume(upright.mesh));
+  const geometry::Box a = geometry::bounding_box(found.mesh), b = geometry::bounding_box(upright.mesh);
   EXPECT_LT((a.lo - b.lo).norm() + (a.hi - b.hi).norm(), 1e-8);
 }
 
@@ -233,23 +233,23 @@ TEST(Orientation, ADieFileOnItsSideIsReadFacingUp) {
 // file's order breaking the cubes' tie; a part the file does not hold is refused naming the count
 // and the largest; each part is its own cache entry.
 TEST(Assembly, APartIsOneBodyOfTheFileNumberedByVolume) {
-  const mesh::TriMesh cube = test::box_mm(0, 4);
-  const mesh::TriMesh plate = mesh::box_solid(Vec3(10e-3, 0, 0), Vec3(30e-3, 20e-3, 8e-3));
-  const mesh::TriMesh second_cube = mesh::box_solid(Vec3(40e-3, 0, 0), Vec3(44e-3, 4e-3, 4e-3));
+  const geometry::TriMesh cube = test::box_mm(0, 4);
+  const geometry::TriMesh plate = mesh::box_solid(Vec3(10e-3, 0, 0), Vec3(30e-3, 20e-3, 8e-3));
+  const geometry::TriMesh second_cube = mesh::box_solid(Vec3(40e-3, 0, 0), Vec3(44e-3, 4e-3, 4e-3));
   test::TempDir dir;
   const auto path = dir / "assembly.stl";
   test::write_text(path, test::ascii_stl(test::joined(test::joined(cube, plate), second_cube)));
   const auto part = [&](int k) {
-    return mesh::read_die_file(path, mesh::LengthUnit::mm, mesh::Up{}, mesh::Parting::automatic, k);
+    return mesh::read_die_file(path, geometry::LengthUnit::mm, mesh::Up{}, mesh::Parting::automatic, k);
   };
   const mesh::DieFile whole = part(0), largest = part(1), second = part(2), third = part(3);
-  EXPECT_NEAR(mesh::signed_volume(whole.mesh), 3200e-9 + 2 * 64e-9, 1e-15);
+  EXPECT_NEAR(geometry::signed_volume(whole.mesh), 3200e-9 + 2 * 64e-9, 1e-15);
   EXPECT_EQ(whole.mesh.triangles.size(), 36u);
-  EXPECT_NEAR(mesh::signed_volume(largest.mesh), 3200e-9, 1e-15);
-  EXPECT_NEAR(mesh::bounding_box(largest.mesh).lo.x(), 10e-3, 1e-9);
-  EXPECT_NEAR(mesh::signed_volume(second.mesh), 64e-9, 1e-16);
-  EXPECT_NEAR(mesh::bounding_box(second.mesh).lo.x(), 0, 1e-9);
-  EXPECT_NEAR(mesh::bounding_box(third.mesh).lo.x(), 40e-3, 1e-9);
+  EXPECT_NEAR(geometry::signed_volume(largest.mesh), 3200e-9, 1e-15);
+  EXPECT_NEAR(geometry::bounding_box(largest.mesh).lo.x(), 10e-3, 1e-9);
+  EXPECT_NEAR(geometry::signed_volume(second.mesh), 64e-9, 1e-16);
+  EXPECT_NEAR(geometry::bounding_box(second.mesh).lo.x(), 0, 1e-9);
+  EXPECT_NEAR(geometry::bounding_box(third.mesh).lo.x(), 40e-3, 1e-9);
   EXPECT_EQ(third.part, 3);
   EXPECT_EQ(whole.bodies, 3u);
   try {
@@ -267,8 +267,8 @@ TEST(Assembly, APartIsOneBodyOfTheFileNumberedByVolume) {
 
 TEST(Import, ReadsFormatsAndWeldsToTheSameSolid) {
   test::TempDir dir;
-  const mesh::TriMesh box = test::box_mm(0, 10);
-  mesh::write_stl(box, dir / "box_bin.stl", mesh::LengthUnit::mm, "solid but binary");
+  const geometry::TriMesh box = test::box_mm(0, 10);
+  mesh::write_stl(box, dir / "box_bin.stl", geometry::LengthUnit::mm, "solid but binary");
   test::write_text(dir / "box_ascii.stl", test::ascii_stl(box));
   std::string obj, off = "OFF\n8 12 0\n", ply;
   for (const Vec3& v : box.vertices) {
@@ -290,14 +290,14 @@ TEST(Import, ReadsFormatsAndWeldsToTheSameSolid) {
     const mesh::ImportResult r = mesh::import_mesh(dir / file);
     EXPECT_EQ(r.mesh.triangles.size(), 12u) << file;
     EXPECT_EQ(r.mesh.vertices.size(), 8u) << file << ": duplicate vertices welded";
-    EXPECT_NEAR(mesh::signed_volume(r.mesh), 1e-6, 1e-15) << file;
+    EXPECT_NEAR(geometry::signed_volume(r.mesh), 1e-6, 1e-15) << file;
   }
   EXPECT_EQ(mesh::import_mesh(dir / "box_bin.stl").vertices_welded, 36u - 8u);
 }
 
 TEST(Import, JoinsSeveralSolidsOfOneFile) {
   test::TempDir dir;
-  const mesh::TriMesh a = test::box_mm(0, 1), b = test::box_mm(2, 3);
+  const geometry::TriMesh a = test::box_mm(0, 1), b = test::box_mm(2, 3);
   test::write_text(dir / "two.stl", test::ascii_stl(a, 1e3, "a") + test::ascii_stl(b, 1e3, "b"));
   std::string obj;
   for (const auto* part : {&a, &b}) {
@@ -311,18 +311,18 @@ TEST(Import, JoinsSeveralSolidsOfOneFile) {
     const mesh::ImportResult r = mesh::import_mesh(dir / file);
     EXPECT_EQ(r.mesh.triangles.size(), 24u) << file;
     EXPECT_EQ(r.mesh.vertices.size(), 16u) << file;
-    EXPECT_NEAR(mesh::signed_volume(r.mesh), 2e-9, 1e-18) << file;
+    EXPECT_NEAR(geometry::signed_volume(r.mesh), 2e-9, 1e-18) << file;
   }
   EXPECT_EQ(mesh::import_mesh(dir / "two.obj").meshes_joined, 2) << "one mesh per OBJ object";
 }
 
 TEST(Import, AppliesDeclaredUnitAndWarnsWhenImplausible) {
   test::TempDir dir;
-  mesh::write_stl(test::box_mm(0, 10), dir / "box.stl", mesh::LengthUnit::mm, "box");
-  const mesh::ImportResult inches = mesh::import_mesh(dir / "box.stl", {mesh::LengthUnit::in});
-  EXPECT_NEAR(mesh::bounding_box(inches.mesh).size().x(), 10 * 0.0254, 1e-12);
+  mesh::write_stl(test::box_mm(0, 10), dir / "box.stl", geometry::LengthUnit::mm, "box");
+  const mesh::ImportResult inches = mesh::import_mesh(dir / "box.stl", {geometry::LengthUnit::in});
+  EXPECT_NEAR(geometry::bounding_box(inches.mesh).size().x(), 10 * 0.0254, 1e-12);
   EXPECT_TRUE(inches.warnings.empty());
-  const mesh::ImportResult metres = mesh::import_mesh(dir / "box.stl", {mesh::LengthUnit::m});
+  const mesh::ImportResult metres = mesh::import_mesh(dir / "box.stl", {geometry::LengthUnit::m});
   ASSERT_EQ(metres.warnings.size(), 1u) << "10 m is no die";
   EXPECT_NE(metres.warnings[0].find("units"), std::string::npos);
 }
@@ -333,22 +333,22 @@ TEST(Import, GuessesAnUndeclaredUnitFromTheSize) {
   test::TempDir dir;
   const struct {
     double side;
-    mesh::LengthUnit unit;
-  } cases[] = {{10, mesh::LengthUnit::mm}, {3, mesh::LengthUnit::mm}, {2.9, mesh::LengthUnit::in},
-               {1, mesh::LengthUnit::in}, {0.99, mesh::LengthUnit::m}, {0.1, mesh::LengthUnit::m}};
+    geometry::LengthUnit unit;
+  } cases[] = {{10, geometry::LengthUnit::mm}, {3, geometry::LengthUnit::mm}, {2.9, geometry::LengthUnit::in},
+               {1, geometry::LengthUnit::in}, {0.99, geometry::LengthUnit::m}, {0.1, geometry::LengthUnit::m}};
   for (const auto& c : cases) {
     // Written in metres, so that the file's numbers are the side as given.
-    mesh::write_stl(test::box_mm(0, 1e3 * c.side), dir / "box.stl", mesh::LengthUnit::m, "box");
+    mesh::write_stl(test::box_mm(0, 1e3 * c.side), dir / "box.stl", geometry::LengthUnit::m, "box");
     const mesh::ImportResult r = mesh::import_mesh(dir / "box.stl", {std::nullopt});
     EXPECT_EQ(r.unit, c.unit) << c.side;
     EXPECT_TRUE(r.unit_guessed);
     // STL stores single-precision coordinates: equal to a part in 10⁷.
-    const double side = c.side * mesh::metres_per_unit(c.unit);
-    EXPECT_NEAR(mesh::bounding_box(r.mesh).size().x(), side, 1e-7 * side) << c.side;
-    EXPECT_EQ(r.warnings.size(), c.unit == mesh::LengthUnit::mm ? 0u : 1u) << c.side;
-    const mesh::ImportResult declared = mesh::import_mesh(dir / "box.stl", {mesh::LengthUnit::mm});
+    const double side = c.side * geometry::metres_per_unit(c.unit);
+    EXPECT_NEAR(geometry::bounding_box(r.mesh).size().x(), side, 1e-7 * side) << c.side;
+    EXPECT_EQ(r.warnings.size(), c.unit == geometry::LengthUnit::mm ? 0u : 1u) << c.side;
+    const mesh::ImportResult declared = mesh::import_mesh(dir / "box.stl", {geometry::LengthUnit::mm});
     EXPECT_FALSE(declared.unit_guessed);
-    EXPECT_EQ(declared.unit, mesh::LengthUnit::mm) << "a declared unit is never second-guessed";
+    EXPECT_EQ(declared.unit, geometry::LengthUnit::mm) << "a declared unit is never second-guessed";
   }
 }
 

@@ -9,7 +9,7 @@
 #include "mesh/weld.hpp"
 #include "meshes.hpp"
 
-using mesh::Vec3;
+using geometry::Vec3;
 
 namespace {
 
@@ -20,7 +20,7 @@ mesh::RepairOptions options_mm(double tolerance_mm = 0.05, double max_hole_mm = 
   return o;
 }
 
-std::string repair_error(const mesh::TriMesh& m, const mesh::RepairOptions& o = options_mm()) {
+std::string repair_error(const geometry::TriMesh& m, const mesh::RepairOptions& o = options_mm()) {
   try {
     mesh::repair(m, o, "part.stl");
   } catch (const diefill::InputError& e) {
@@ -32,7 +32,7 @@ std::string repair_error(const mesh::TriMesh& m, const mesh::RepairOptions& o = 
 }  // namespace
 
 TEST(Inspect, CountsDefects) {
-  mesh::TriMesh box = test::box_mm(0, 10);
+  geometry::TriMesh box = test::box_mm(0, 10);
   const mesh::MeshReport clean = mesh::inspect(box);
   EXPECT_TRUE(clean.closed);
   EXPECT_EQ(clean.orientation, "outward");
@@ -41,31 +41,31 @@ TEST(Inspect, CountsDefects) {
   EXPECT_NEAR(clean.volume_m3, 1e-6, 1e-15);
   EXPECT_NEAR(clean.area_m2, 6e-4, 1e-15);
 
-  mesh::TriMesh open = box;
+  geometry::TriMesh open = box;
   open.triangles.pop_back();
   EXPECT_EQ(mesh::inspect(open).boundary_edges, 3u);
   EXPECT_FALSE(mesh::inspect(open).closed);
 
-  mesh::TriMesh flipped_face = box;
+  geometry::TriMesh flipped_face = box;
   std::swap(flipped_face.triangles[0][1], flipped_face.triangles[0][2]);
   EXPECT_EQ(mesh::inspect(flipped_face).inconsistent_edges, 3u);
   EXPECT_EQ(mesh::inspect(flipped_face).orientation, "inconsistent");
 
-  mesh::TriMesh fin = box;  // a third triangle on a box edge: non-manifold
+  geometry::TriMesh fin = box;  // a third triangle on a box edge: non-manifold
   fin.vertices.emplace_back(-5e-3, -5e-3, 5e-3);
   fin.triangles.push_back({0, 1, 8});
   EXPECT_EQ(mesh::inspect(fin).non_manifold_edges, 1u);
 
-  mesh::TriMesh sliver = box;  // zero area: collinear points, and a repeated index
+  geometry::TriMesh sliver = box;  // zero area: collinear points, and a repeated index
   sliver.vertices.emplace_back(5e-3, 0, 0);
   sliver.triangles.push_back({0, 8, 1});
   sliver.triangles.push_back({0, 0, 1});
   EXPECT_EQ(mesh::inspect(sliver).degenerate_faces, 2u);
 
-  const mesh::TriMesh overlapping = test::joined(box, test::box_mm(5, 15));
+  const geometry::TriMesh overlapping = test::joined(box, test::box_mm(5, 15));
   EXPECT_EQ(mesh::inspect(overlapping).shells, 2u);
   EXPECT_GT(mesh::inspect(overlapping).self_intersections, 0u);
-  mesh::TriMesh twice = test::joined(box, box);
+  geometry::TriMesh twice = test::joined(box, box);
   mesh::weld_exact(twice);
   EXPECT_EQ(mesh::inspect(twice).duplicate_faces, 12u);
 }
@@ -79,7 +79,7 @@ TEST(Repair, LeavesACleanSolidAlone) {
 
 TEST(Repair, OrientsPartlyFlippedFacesOutward) {
   // Half the faces reversed: the surface has one evident outside, whichever half was wrong.
-  mesh::TriMesh box = test::box_mm(0, 10);
+  geometry::TriMesh box = test::box_mm(0, 10);
   for (std::size_t f = 0; f < box.triangles.size(); f += 2) std::swap(box.triangles[f][1], box.triangles[f][2]);
   const mesh::RepairResult r = mesh::repair(box, options_mm(), "box.stl");
   EXPECT_EQ(r.before.orientation, "inconsistent");
@@ -97,7 +97,7 @@ TEST(Repair, RefusesASurfaceTurnedInsideOut) {
 }
 
 TEST(Repair, MakesDoubleSidedSurfacesSingle) {
-  const mesh::TriMesh box = test::box_mm(0, 10);
+  const geometry::TriMesh box = test::box_mm(0, 10);
   const mesh::RepairResult r = mesh::repair(test::joined(box, test::reversed(box)), options_mm(), "box.stl");
   EXPECT_EQ(r.after.triangles, 12u);
   EXPECT_NEAR(r.after.volume_m3, 1e-6, 1e-15);
@@ -105,7 +105,7 @@ TEST(Repair, MakesDoubleSidedSurfacesSingle) {
 
 TEST(Repair, FillsASmallHoleWithoutMovingTheSurface) {
   // A 10 mm box whose top is split finely, one small triangle missing.
-  mesh::TriMesh m = test::box_mm(0, 10);
+  geometry::TriMesh m = test::box_mm(0, 10);
   m.triangles.pop_back();  // a whole half face: 14 mm across, larger than max_hole
   EXPECT_EQ(repair_error(m).rfind("boundary edges", 0), 0u) << repair_error(m);
   const mesh::RepairResult r = mesh::repair(m, options_mm(0.05, 20.0), "box.stl");
@@ -133,7 +133,7 @@ TEST(Repair, UnitesIntersectingShellsExactly) {
 // the 0.05 mm tolerance) removes the folds and moves nothing farther than 2 µm.
 TEST(Repair, WeldsAFoldAtASeamMicronsAcross) {
   const double fold = 2e-6;
-  mesh::TriMesh cube;
+  geometry::TriMesh cube;
   cube.vertices = {Vec3(0, 0, 0),        Vec3(10e-3, 0, 0),     Vec3(10e-3, 10e-3, 0),     Vec3(0, 10e-3, 0),
                    Vec3(0, 0, 10e-3),    Vec3(10e-3, 0, 10e-3), Vec3(10e-3, 10e-3, 10e-3), Vec3(0, 10e-3, 10e-3),
                    Vec3(5e-3 + fold / 2, 0, 10e-3), Vec3(5e-3 - fold / 2, 0, 10e-3)};
@@ -157,33 +157,33 @@ TEST(Repair, WeldsAFoldAtASeamMicronsAcross) {
 // chain: of three points 0.6 of it apart in a row, the middle one moves and the last stays.
 TEST(Weld, MovesAVertexNoFartherThanTheWeldDistance) {
   const double d = 1e-6;
-  const mesh::TriMesh row{{Vec3(0, 0, 0), Vec3(0.6 * d, 0, 0), Vec3(1.2 * d, 0, 0), Vec3(0, 1e-3, 0)},
-                          {{0, 1, 3}, {1, 2, 3}}};
+  const geometry::TriMesh row{{Vec3(0, 0, 0), Vec3(0.6 * d, 0, 0), Vec3(1.2 * d, 0, 0), Vec3(0, 1e-3, 0)},
+                              {{0, 1, 3}, {1, 2, 3}}};
   const mesh::WeldedMesh w = mesh::weld_close_vertices(row, d);
   EXPECT_EQ(w.merged, 1u);
   EXPECT_DOUBLE_EQ(w.moved_m, 0.6 * d);
   ASSERT_EQ(w.mesh.triangles.size(), 1u) << "the triangle left with a repeated corner is dropped";
-  EXPECT_EQ(w.mesh.triangles[0], (mesh::Triangle{0, 2, 3}));
+  EXPECT_EQ(w.mesh.triangles[0], (geometry::Triangle{0, 2, 3}));
 }
 
 TEST(Repair, RefusesWhatItCannotRepairWithinTolerance) {
-  EXPECT_EQ(repair_error(mesh::TriMesh{{Vec3(0, 0, 0), Vec3(1e-3, 0, 0), Vec3(0, 1e-3, 0)}, {{0, 1, 2}}})
+  EXPECT_EQ(repair_error(geometry::TriMesh{{Vec3(0, 0, 0), Vec3(1e-3, 0, 0), Vec3(0, 1e-3, 0)}, {{0, 1, 2}}})
                 .rfind("triangles", 0),
             0u);
-  mesh::TriMesh open_box = test::box_mm(0, 10);
+  geometry::TriMesh open_box = test::box_mm(0, 10);
   open_box.triangles.resize(10);  // one face missing
   EXPECT_EQ(repair_error(open_box).rfind("boundary edges", 0), 0u) << repair_error(open_box);
-  const mesh::TriMesh nested = test::joined(test::box_mm(0, 10), test::box_mm(2, 8));
+  const geometry::TriMesh nested = test::joined(test::box_mm(0, 10), test::box_mm(2, 8));
   EXPECT_EQ(repair_error(nested).rfind("shells", 0), 0u) << repair_error(nested);
 }
 
 TEST(Tool, IsTheTableBlockMinusTheCavity) {
-  const mesh::TriMesh ring = mesh::bundled_die("ring");
+  const geometry::TriMesh ring = mesh::bundled_die("ring");
   const mesh::TableExtent table{-20e-3, -15e-3, 25e-3, 15e-3, 5e-3};
   const mesh::ToolMesh tool = mesh::tool_from_cavity(ring, table, "ring.stl");
   EXPECT_DOUBLE_EQ(tool.table_z, 0.0);
   const double block = 45e-3 * 30e-3 * 15e-3;
-  EXPECT_NEAR(mesh::signed_volume(tool.mesh), block - mesh::signed_volume(ring), 1e-15);
+  EXPECT_NEAR(geometry::signed_volume(tool.mesh), block - geometry::signed_volume(ring), 1e-15);
   const mesh::MeshReport report = mesh::inspect(tool.mesh);
   EXPECT_TRUE(report.closed);
   EXPECT_EQ(report.orientation, "outward");

@@ -1,4 +1,4 @@
-// mesh/winding and the repair route it opens: analytic winding numbers, the fast evaluation
+// geometry/winding and the repair route it opens: analytic winding numbers, the fast evaluation
 // against the exact sum, the ray majority that checks it, and a cracked solid re-meshed without
 // moving its surface.
 #include <gtest/gtest.h>
@@ -8,21 +8,21 @@
 #include <utility>
 
 #include "core/error.hpp"
+#include "geometry/winding.hpp"
 #include "mesh/exact.hpp"
 #include "mesh/repair.hpp"
 #include "mesh/shapes.hpp"
-#include "mesh/winding.hpp"
 #include "mesh/winding_solid.hpp"
 #include "meshes.hpp"
 
-using mesh::Vec3;
+using geometry::Vec3;
 
 namespace {
 
 Vec3 mm(double x, double y, double z) { return 1e-3 * Vec3(x, y, z); }
 
-mesh::TriMesh without_top(mesh::TriMesh box) {
-  std::erase_if(box.triangles, [&](const mesh::Triangle& t) {
+geometry::TriMesh without_top(geometry::TriMesh box) {
+  std::erase_if(box.triangles, [&](const geometry::Triangle& t) {
     return box.vertices[t[0]].z() > 9e-3 && box.vertices[t[1]].z() > 9e-3 && box.vertices[t[2]].z() > 9e-3;
   });
   return box;
@@ -31,25 +31,25 @@ mesh::TriMesh without_top(mesh::TriMesh box) {
 }  // namespace
 
 TEST(WindingNumber, CountsAClosedSolidOnceInsideAndNeverOutside) {
-  const mesh::TriMesh box = test::box_mm(0, 10);
+  const geometry::TriMesh box = test::box_mm(0, 10);
   for (const Vec3& p : {mm(5, 5, 5), mm(0.01, 9.99, 0.01), mm(1, 2, 3)})
-    EXPECT_NEAR(mesh::exact_winding_number(box, p), 1.0, 1e-12);
+    EXPECT_NEAR(geometry::exact_winding_number(box, p), 1.0, 1e-12);
   for (const Vec3& p : {mm(-0.01, 5, 5), mm(20, 20, 20), mm(5, 5, 10.01)})
-    EXPECT_NEAR(mesh::exact_winding_number(box, p), 0.0, 1e-12);
+    EXPECT_NEAR(geometry::exact_winding_number(box, p), 0.0, 1e-12);
   // Two overlapping solids count twice where they overlap.
-  EXPECT_NEAR(mesh::exact_winding_number(test::joined(box, test::box_mm(5, 15)), mm(7, 7, 7)), 2.0, 1e-12);
+  EXPECT_NEAR(geometry::exact_winding_number(test::joined(box, test::box_mm(5, 15)), mm(7, 7, 7)), 2.0, 1e-12);
 }
 
 TEST(WindingNumber, MeasuresTheSolidAngleOfAnOpenSurface) {
   // A box without its top: from the centre each of the five faces subtends a sixth of the
   // sphere; a point in the missing face's plane sees the open boundary as a half space inside
   // the loop and edge-on outside it.
-  const mesh::TriMesh open = without_top(test::box_mm(0, 10));
+  const geometry::TriMesh open = without_top(test::box_mm(0, 10));
   ASSERT_EQ(open.triangles.size(), 10u);
-  EXPECT_NEAR(mesh::exact_winding_number(open, mm(5, 5, 5)), 5.0 / 6.0, 1e-12);
-  EXPECT_NEAR(mesh::exact_winding_number(open, mm(5, 5, 10)), 0.5, 1e-12);
-  EXPECT_NEAR(mesh::exact_winding_number(open, mm(3, 7, 10)), 0.5, 1e-12);
-  EXPECT_NEAR(mesh::exact_winding_number(open, mm(15, 5, 10)), 0.0, 1e-12);
+  EXPECT_NEAR(geometry::exact_winding_number(open, mm(5, 5, 5)), 5.0 / 6.0, 1e-12);
+  EXPECT_NEAR(geometry::exact_winding_number(open, mm(5, 5, 10)), 0.5, 1e-12);
+  EXPECT_NEAR(geometry::exact_winding_number(open, mm(3, 7, 10)), 0.5, 1e-12);
+  EXPECT_NEAR(geometry::exact_winding_number(open, mm(15, 5, 10)), 0.0, 1e-12);
 }
 
 // The independent check of issue 19's sign test counts along each ray every face it crosses.
@@ -60,7 +60,7 @@ TEST(WindingNumber, MeasuresTheSolidAngleOfAnOpenSurface) {
 // against the file's winding number). Counting every hit, the majority of 7 rays is the winding
 // number's verdict at every point.
 TEST(ExactSurface, RayMajorityCountsTheCoincidentFacesOfTouchingShells) {
-  const mesh::TriMesh stack =
+  const geometry::TriMesh stack =
       test::joined(mesh::box_solid(mm(0, 0, 0), mm(10, 10, 10)), mesh::box_solid(mm(0, 0, 10), mm(10, 10, 11)));
   const mesh::ExactSurface rays(stack);
   std::mt19937_64 random(3);
@@ -68,7 +68,7 @@ TEST(ExactSurface, RayMajorityCountsTheCoincidentFacesOfTouchingShells) {
   int wrong = 0, inside = 0;
   for (int n = 0; n < 2000; ++n) {
     const Vec3 p(across(random), across(random), up(random));
-    const bool by_winding = mesh::exact_winding_number(stack, p) >= 0.5;
+    const bool by_winding = geometry::exact_winding_number(stack, p) >= 0.5;
     inside += by_winding;
     wrong += rays.inside_by_ray_majority(p, 7) != by_winding;
   }
@@ -79,9 +79,9 @@ TEST(ExactSurface, RayMajorityCountsTheCoincidentFacesOfTouchingShells) {
 TEST(WindingNumber, FastEvaluationClassifiesAsTheExactSum) {
   // A ring cavity of a few thousand triangles: the tree's far clusters are dipoles. Points a
   // hundredth of the ring's size or more from its surface are never classified differently.
-  const mesh::TriMesh ring = mesh::ring_cavity(30e-3, 12e-3, 10e-3, 2e-6);
+  const geometry::TriMesh ring = mesh::ring_cavity(30e-3, 12e-3, 10e-3, 2e-6);
   ASSERT_GT(ring.triangles.size(), 1000u);
-  const mesh::WindingNumber fast(ring);
+  const geometry::WindingNumber fast(ring);
   std::mt19937_64 random(7);
   std::uniform_real_distribution<double> across(-20e-3, 20e-3), down(-15e-3, 5e-3);
   int compared = 0;
@@ -91,7 +91,7 @@ TEST(WindingNumber, FastEvaluationClassifiesAsTheExactSum) {
     const double clearance = std::min({std::abs(radius - 15e-3), std::abs(radius - 6e-3), std::abs(p.z()),
                                        std::abs(p.z() + 10e-3)});
     if (clearance < 0.3e-3) continue;
-    const double exact = mesh::exact_winding_number(ring, p);
+    const double exact = geometry::exact_winding_number(ring, p);
     const bool inside = radius > 6e-3 && radius < 15e-3 && p.z() < 0 && p.z() > -10e-3;
     ASSERT_NEAR(exact, inside ? 1.0 : 0.0, 1e-9) << p.transpose();
     ASSERT_EQ(fast(p) >= 0.5, inside) << p.transpose() << " exact " << exact << " fast " << fast(p);
@@ -102,8 +102,8 @@ TEST(WindingNumber, FastEvaluationClassifiesAsTheExactSum) {
 TEST(Repair, ClosesACrackByTheWindingNumberWithinTheTolerance) {
   // The top face lifted 0.05 mm off the walls, unwelded: a crack all round, its loops 10 mm
   // across (too wide to fill as holes), enclosing an evident 10 x 10 x 10.05 mm solid.
-  const mesh::TriMesh box = test::box_mm(0, 10);
-  mesh::TriMesh top;
+  const geometry::TriMesh box = test::box_mm(0, 10);
+  geometry::TriMesh top;
   top.vertices = {mm(0, 0, 10.05), mm(10, 0, 10.05), mm(10, 10, 10.05), mm(0, 10, 10.05)};
   top.triangles = {{0, 1, 2}, {0, 2, 3}};
   mesh::RepairOptions options;
@@ -143,20 +143,20 @@ TEST(Repair, NamesTheRegionWhereTheEnclosedVolumeIsUndefined) {
 // and their box, on an open box (the winding number drifts through ½ around its opening), two
 // overlapping boxes (2 where they overlap) and a box with a post and a missing wall.
 TEST(WindingSurvey, CountsAsEveryCellReadOneByOne) {
-  const mesh::TriMesh die = test::joined(test::box_mm(0, 10), test::reversed(mesh::box_solid(mm(3, 3, 0), mm(7, 7, 4))));
-  mesh::TriMesh missing_wall = die;
-  std::erase_if(missing_wall.triangles, [&](const mesh::Triangle& t) {
+  const geometry::TriMesh die = test::joined(test::box_mm(0, 10), test::reversed(mesh::box_solid(mm(3, 3, 0), mm(7, 7, 4))));
+  geometry::TriMesh missing_wall = die;
+  std::erase_if(missing_wall.triangles, [&](const geometry::Triangle& t) {
     return missing_wall.vertices[t[0]].x() < 1e-6 && missing_wall.vertices[t[1]].x() < 1e-6 && missing_wall.vertices[t[2]].x() < 1e-6;
   });
-  for (const mesh::TriMesh& soup : {without_top(test::box_mm(0, 10)), test::joined(test::box_mm(0, 10), test::box_mm(5, 15)), missing_wall}) {
+  for (const geometry::TriMesh& soup : {without_top(test::box_mm(0, 10)), test::joined(test::box_mm(0, 10), test::box_mm(5, 15)), missing_wall}) {
     // 48 cells along the longest side (the repair's 96 read one by one are slow under the sanitizers).
     const mesh::detail::WindingSurvey survey = mesh::detail::survey_winding(soup, 48);
-    const mesh::WindingNumber winding(soup);
-    const mesh::Box box = mesh::bounding_box(soup);
+    const geometry::WindingNumber winding(soup);
+    const geometry::Box box = geometry::bounding_box(soup);
     const double h = box.size().maxCoeff() / 48;
     const Eigen::Vector3i n = (box.size() / h).array().ceil().cast<int>().max(1);
     long solid = 0, ambiguous = 0;
-    mesh::Box ambiguous_box;
+    geometry::Box ambiguous_box;
     for (int k = 0; k < n.z(); ++k)
       for (int j = 0; j < n.y(); ++j)
         for (int i = 0; i < n.x(); ++i) {
@@ -189,8 +189,8 @@ TEST(WindingSurvey, CountsAsEveryCellReadOneByOne) {
 // (5 mm from the block it stood out of).
 TEST(WindingSolid, ClosesOnlyFreeSpaceNoGrainOfTheClosableDiameterTouches) {
   const double cell = 0.5e-3;
-  const mesh::TriMesh gap = test::joined(test::box_mm(0, 10), mesh::box_solid(mm(10.15, 0, 0), mm(20, 10, 10)));
-  const mesh::TriMesh plate = test::joined(test::box_mm(0, 10), mesh::box_solid(mm(10, 0, 4.9), mm(15, 10, 5.1)));
+  const geometry::TriMesh gap = test::joined(test::box_mm(0, 10), mesh::box_solid(mm(10.15, 0, 0), mm(20, 10, 10)));
+  const geometry::TriMesh plate = test::joined(test::box_mm(0, 10), mesh::box_solid(mm(10, 0, 4.9), mm(15, 10, 5.1)));
   const mesh::detail::ClosableGaps tool{cell, false}, cavity{cell, true};
   for (const auto& [soup, free_space, other_role] : {std::tuple{gap, tool, cavity}, std::tuple{plate, cavity, tool}}) {
     const mesh::detail::WindingSolid closed = mesh::detail::winding_solid(soup, cell, free_space, 2e9);
@@ -210,12 +210,12 @@ TEST(WindingSolid, ClosesOnlyFreeSpaceNoGrainOfTheClosableDiameterTouches) {
 // moved 5 mm, as before.
 TEST(WindingSolid, JoinsPartsInContactAcrossTheSliverTheirFacetingLeaves) {
   const double cell = 0.5e-3;
-  const mesh::TriMesh base = test::joined(mesh::box_solid(mm(0, 0, 0), mm(5, 10, 5)), mesh::box_solid(mm(5, 0, 0), mm(10, 10, 5)));
+  const geometry::TriMesh base = test::joined(mesh::box_solid(mm(0, 0, 0), mm(5, 10, 5)), mesh::box_solid(mm(5, 0, 0), mm(10, 10, 5)));
   for (const auto& [slit_mm, in_contact] : {std::pair{0.02, true}, std::pair{0.15, false}}) {
     SCOPED_TRACE(slit_mm);
     const double half = 0.5 * slit_mm;
-    const mesh::TriMesh soup = test::joined(base, test::joined(mesh::box_solid(mm(0, 0, 5), mm(5 - half, 10, 10)),
-                                                               mesh::box_solid(mm(5 + half, 0, 5), mm(10, 10, 10))));
+    const geometry::TriMesh soup = test::joined(base, test::joined(mesh::box_solid(mm(0, 0, 5), mm(5 - half, 10, 10)),
+                                                                   mesh::box_solid(mm(5 + half, 0, 5), mm(10, 10, 10))));
     const mesh::detail::WindingSolid solid = mesh::detail::winding_solid(soup, cell, {cell, true}, 2e9);
     if (in_contact) {
       EXPECT_LE(solid.moved_m, cell) << solid.moved_most_at.transpose() * 1e3;
@@ -231,11 +231,11 @@ TEST(WindingSolid, JoinsPartsInContactAcrossTheSliverTheirFacetingLeaves) {
 // repair closes it and says so; for a cavity it is a die wall 0.15 mm thick between two parts of
 // the cavity, which the cells would remove, and repair refuses, saying so and naming die.part.
 TEST(Repair, ClosesAGapNoGrainTouchesForAToolAndRefusesToJoinACavityAcrossAThinWall) {
-  mesh::TriMesh top;
+  geometry::TriMesh top;
   top.vertices = {mm(0, 0, 10.05), mm(10, 0, 10.05), mm(10, 10, 10.05), mm(0, 10, 10.05)};
   top.triangles = {{0, 1, 2}, {0, 2, 3}};
-  const mesh::TriMesh soup = test::joined(test::joined(without_top(test::box_mm(0, 10)), top),
-                                          mesh::box_solid(mm(10.15, 0, 0), mm(20, 10, 10)));
+  const geometry::TriMesh soup = test::joined(test::joined(without_top(test::box_mm(0, 10)), top),
+                                              mesh::box_solid(mm(10.15, 0, 0), mm(20, 10, 10)));
   mesh::RepairOptions options;
   options.tolerance_m = 0.5e-3;
   options.max_hole_m = 2e-3;

@@ -171,8 +171,8 @@ void expect_same_forces(const std::map<std::int64_t, Vec3>& a, const std::map<st
 
 // Four overlapping spheres of radius r in a cross, longer along x than y (test_clump_dem.cpp):
 // volume and moments of the spheres, overlaps counted twice, a stand-in for a grain mesh.
-mesh::ClumpTemplate cross(double r) {
-  mesh::ClumpTemplate t;
+geometry::ClumpTemplate cross(double r) {
+  geometry::ClumpTemplate t;
   const double v = 4.0 / 3.0 * std::numbers::pi * r * r * r;
   for (const Vec3& c : {Vec3(1.6 * r, 0, 0), Vec3(-1.6 * r, 0, 0), Vec3(0, 0.7 * r, 0), Vec3(0, -0.7 * r, 0)}) {
     t.spheres.push_back({c, r});
@@ -189,7 +189,7 @@ dem::State clump_lattice(double speed) {
   dem::State s;
   dem::Random random(29);
   const double r = 0.25e-3;
-  const mesh::ClumpTemplate t = cross(r);
+  const geometry::ClumpTemplate t = cross(r);
   const Vec3 spacing = 0.98 * Vec3(5.2 * r, 3.4 * r, 2 * r);
   const int sides[3] = {8, 12, 20};
   for (int a = 0; a < sides[0]; ++a)
@@ -292,7 +292,7 @@ TEST(MpiSplit, ForcesAndMotionMatchTheWholeSceneAndNoGrainIsLostOrDoubled) {
 // Frictional, rolling grains of radius about r under gravity with the bundled ring die as a mesh
 // wall (the table at z = 0, the cavity 10 mm deep between radii 5 and 10 mm).
 dem::ModelSpec ring_spec(double r) {
-  const mesh::TriMesh ring = mesh::bundled_die("ring");
+  const geometry::TriMesh ring = mesh::bundled_die("ring");
   const mesh::ToolMesh tool = mesh::tool_from_cavity(ring, mesh::table_around(ring, 3e-3), "ring");
   dem::ModelSpec spec = test::spec_with({test::glass(0.5, 0.4), test::rigid_wall(0.5, 0.3)}, Vec3(0, 0, -9.81));
   spec.materials[0].rolling_friction = spec.materials[1].rolling_friction = 0.1;

@@ -250,8 +250,8 @@ TEST(Pipeline, SmoothedFieldShowsTheWallLayerOfTheGrainCentres) {
     if (s.x[i].z() < 0 && s.x[i].z() > -10e-3 && s.x[i].head<2>().norm() > 5e-3 && s.x[i].head<2>().norm() < 10e-3)
       grains.push_back({s.x[i], s.radius[i], 1.0});
   const mesh::PreparedDie die = mesh::prepare_die(bundled_die("ring"), mesh::die_options_for_grains(d / 2, d / 4), std::nullopt);
-  const mesh::WallField walls = die.sdf.wall_field(die.solid);
-  pipeline::DensitySettings settings;
+  const geometry::WallField walls = die.sdf.wall_field(die.solid);
+  pipeline::DensityOptions settings;
   settings.voxel_m = 2 * d;
   settings.smoothed_width_m = width;
   const pipeline::DensityResult field = pipeline::compute_density(grains, die, walls, 7800, settings, "ring");
@@ -590,7 +590,7 @@ TEST(PipelineOwnRuns, MeshThatCrashedCorefinementIsRefusedClearly) {
 TEST(Pipeline, ShoeFromAMeshFillsLikeTheBox) {
   test::TempDir dir;
   // The box shoe trimmed to the ring: 32 mm long, 20 + 2 x 4 mm wide, 37 mm high, 3 mm walls.
-  mesh::write_stl(mesh::shoe_solid(32e-3, 28e-3, 37e-3, 3e-3), dir / "shoe.stl", mesh::LengthUnit::mm, "shoe");
+  mesh::write_stl(mesh::shoe_solid(32e-3, 28e-3, 37e-3, 3e-3), dir / "shoe.stl", geometry::LengthUnit::mm, "shoe");
   const double box = run("ring", 0.1, 1)["fill"]["fill_ratio"].get<double>();
   const nlohmann::json& r = run("ring", 0.1, 1, "mesh_shoe", coarse + " shoe.mesh=\"" + (dir / "shoe.stl").string() + "\"");
   const double from_mesh = r["fill"]["fill_ratio"].get<double>();

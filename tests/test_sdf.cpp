@@ -1,4 +1,4 @@
-// mesh/sdf and mesh/wall_field against the exact Embree distance on the bundled dies; the cache.
+// mesh/sdf and geometry/wall_field against the exact Embree distance on the bundled dies; the cache.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -13,7 +13,7 @@
 #include "meshes.hpp"
 #include "support.hpp"
 
-using mesh::Vec3;
+using geometry::Vec3;
 
 namespace {
 
@@ -28,7 +28,7 @@ TEST_P(SdfOnBundledDie, MatchesTheExactDistance) {
   const mesh::PreparedDie die =
       mesh::prepare_die(test::source_dir() / "dies" / (name + ".stl"), default_options(), std::nullopt);
   const mesh::ExactSurface exact(die.solid);
-  const mesh::WallField field = die.sdf.wall_field(die.solid);
+  const geometry::WallField field = die.sdf.wall_field(die.solid);
   const mesh::SdfVerification v = mesh::verify_sdf(field, die.solid, exact, 12000, 7);
   ASSERT_EQ(v.samples, 12000u);
   ASSERT_GE(v.smooth_samples, 10000u);
@@ -72,12 +72,12 @@ class SignAtSharpFeatures : public ::testing::TestWithParam<std::string> {};
 TEST_P(SignAtSharpFeatures, IsTheExactSignBesideEveryEdgeAndCorner) {
   const std::string name = GetParam();
   test::TempDir dir;
-  const mesh::TriMesh cavity = mesh::bundled_die(name);
-  mesh::write_stl(cavity, dir / "die.stl", mesh::LengthUnit::mm, "diefill " + name + " cavity, mm");
+  const geometry::TriMesh cavity = mesh::bundled_die(name);
+  mesh::write_stl(cavity, dir / "die.stl", geometry::LengthUnit::mm, "diefill " + name + " cavity, mm");
   const double r = 0.4e-3;
   const mesh::PreparedDie die = mesh::prepare_die(dir / "die.stl", mesh::die_options_for_grains(r, 0.5 * r), std::nullopt);
   const mesh::ExactSurface exact(die.solid);
-  const mesh::WallField field = die.sdf.wall_field(die.solid);
+  const geometry::WallField field = die.sdf.wall_field(die.solid);
   std::mt19937_64 random(5);
   std::uniform_real_distribution<double> unit(-1.0, 1.0), reach(0.02e-3, 0.8e-3);
   std::size_t checked = 0, field_wrong = 0, contact_wrong = 0;
@@ -96,7 +96,7 @@ TEST_P(SignAtSharpFeatures, IsTheExactSignBesideEveryEdgeAndCorner) {
         if ((field.signed_distance(p) < 0) != (truth < 0)) {
           if (field_wrong++ == 0) first_wrong = p;
         }
-        mesh::SurfacePoint contacts[4];
+        geometry::SurfacePoint contacts[4];
         const int count = field.local_minima(p, r, contacts, 4);
         for (int c = 0; c < count; ++c) contact_wrong += (contacts[c].distance < 0) != (truth < 0);
       }
@@ -135,9 +135,9 @@ TEST(Sdf, ASealedVoidThinnerThanAVoxelKeepsTheBandAroundIt) {
   const double h = 1e-3;
   for (const double thickness : {0.15, 0.45, 0.7}) {
     for (const double offset : {0.0, 0.37}) {
-      const mesh::TriMesh void_faces =
+      const geometry::TriMesh void_faces =
           mesh::box_solid(Vec3(2e-3, 2e-3, (5 + offset) * h), Vec3(8e-3, 8e-3, (5 + offset + thickness) * h));
-      const mesh::TriMesh solid =
+      const geometry::TriMesh solid =
           test::joined(mesh::box_solid(Vec3(0, 0, 0), Vec3(10e-3, 10e-3, 10e-3)), test::reversed(void_faces));
       const mesh::SdfGrid sdf = mesh::build_sdf(solid, {h, 1.65 * h, 3 * h, false});
       const mesh::ExactSurface exact(solid);
@@ -203,9 +203,9 @@ TEST(Sdf, CachedGridReadsBackWithMetadata) {
 TEST(Sdf, InteriorBandHoldsATrilinearSampleOneAndAHalfVoxelsDeep) {
   const mesh::DieOptions o = default_options();
   const double top = 10.06e-3;  // between grid planes (the voxel is 0.125 mm)
-  const mesh::TriMesh box = mesh::box_solid(Vec3::Zero(), Vec3(10e-3, 10e-3, top));
+  const geometry::TriMesh box = mesh::box_solid(Vec3::Zero(), Vec3(10e-3, 10e-3, top));
   const mesh::SdfGrid sdf = mesh::build_sdf(box, {o.voxel_m, o.exterior_band_m, o.interior_band_m, false});
-  const mesh::WallField field = sdf.wall_field(box);
+  const geometry::WallField field = sdf.wall_field(box);
   std::mt19937_64 random(3);
   std::uniform_real_distribution<double> across(3e-3, 7e-3), depth(1.4, 1.6);
   for (int n = 0; n < 200; ++n) {
@@ -226,13 +226,13 @@ TEST(Sdf, InteriorBandHoldsATrilinearSampleOneAndAHalfVoxelsDeep) {
 // both faces of the corner are contacts.
 TEST(WallQuery, TrackedQueriesOnSliversFindTheExactClosestPointAsFreshOnesDo) {
   const double radius = 10e-3, chord = 2e-10;
-  const mesh::TriMesh cavity = mesh::ring_cavity(2 * radius, 0.0, 10e-3, chord);
-  const mesh::TriMesh tool = mesh::tool_from_cavity(cavity, mesh::table_around(cavity, 3e-3), "slivers").mesh;
+  const geometry::TriMesh cavity = mesh::ring_cavity(2 * radius, 0.0, 10e-3, chord);
+  const geometry::TriMesh tool = mesh::tool_from_cavity(cavity, mesh::table_around(cavity, 3e-3), "slivers").mesh;
   mesh::SdfOptions o;
   o.voxel_m = 0.125e-3;
   o.exterior_band_m = 8 * o.voxel_m;
   o.interior_band_m = 2 * o.voxel_m;
-  const mesh::WallField field = mesh::build_sdf(tool, o).wall_field(tool);
+  const geometry::WallField field = mesh::build_sdf(tool, o).wall_field(tool);
   const mesh::ExactSurface exact(tool);
   const int segments = int(cavity.triangles.size()) / 4;  // two per side quad, one in each cap's fan
   ASSERT_GT(segments, 15000);
@@ -249,7 +249,7 @@ TEST(WallQuery, TrackedQueriesOnSliversFindTheExactClosestPointAsFreshOnesDo) {
       cell = field.cell_of(p);
       count = field.cell_candidates(cell, seeds);
     }
-    mesh::SurfacePoint tracked[4], fresh[4];
+    geometry::SurfacePoint tracked[4], fresh[4];
     const int n = field.local_minima_tracked(p, range, seeds, count, tracked, 4);
     const int m = field.local_minima(p, range, fresh, 4);
     ASSERT_GT(n, 0) << "step " << step;

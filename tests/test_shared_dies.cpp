@@ -15,7 +15,7 @@ namespace {
 
 struct SharedDie {
   const char* file;
-  mesh::LengthUnit unit;  // from SOURCES.md: files store none
+  geometry::LengthUnit unit;  // from SOURCES.md: files store none
   const char* defect;     // nullptr: must load; else the error must name this
   // The voxel [mm] for a file whose winding-number solid (docs/MESHES.md, "Mesh repair") is affordable
   // only coarser than 1/300 of the part; such a file's field is also checked against Embree's
@@ -28,39 +28,39 @@ struct SharedDie {
 
 // Why each refused mesh is refused, in the words the error must contain.
 const SharedDie shared_dies[] = {
-    {"blind_flange_disc_trimesh_counter_mm.stl", mesh::LengthUnit::mm, nullptr},  // 6 shells united
-    {"stepped_bushing_gazebo_coupling_doublesided.stl", mesh::LengthUnit::mm, nullptr},  // made single-sided
+    {"blind_flange_disc_trimesh_counter_mm.stl", geometry::LengthUnit::mm, nullptr},         // 6 shells united
+    {"stepped_bushing_gazebo_coupling_doublesided.stl", geometry::LengthUnit::mm, nullptr},  // made single-sided
     // No flat face at any extreme: laid flat and cut at its widest section (die.parting), its
     // field's sign checked on the file below the table.
-    {"large_turbineblade_vtk_199k.ply", mesh::LengthUnit::mm, nullptr, 0.25, mesh::WallRole::cavity},
+    {"large_turbineblade_vtk_199k.ply", geometry::LengthUnit::mm, nullptr, 0.25, mesh::WallRole::cavity},
     // Slits up to 0.63 mm wide: its winding-number solid costs more than allowed at cells of 0.125 mm
     // (voxels of 0.25 mm, 1/300 of the part); about 0.17 mm is affordable.
-    {"flanged_ring_trimesh_idler_riser.stl", mesh::LengthUnit::in, nullptr, 0.4},
-    {"gear_8tooth_open_thingi10k_50736.stl", mesh::LengthUnit::mm, nullptr},  // T-junction seams: winding number
-    {"sprocket_hub_chrono_m113_singlepin.obj", mesh::LengthUnit::m, nullptr, 2.0},  // open visual mesh
+    {"flanged_ring_trimesh_idler_riser.stl", geometry::LengthUnit::in, nullptr, 0.4},
+    {"gear_8tooth_open_thingi10k_50736.stl", geometry::LengthUnit::mm, nullptr},        // T-junction seams: winding number
+    {"sprocket_hub_chrono_m113_singlepin.obj", geometry::LengthUnit::m, nullptr, 2.0},  // open visual mesh
     // Its ring gear folds through itself at a seam, in slivers microns across: welded (see
     // SharedDieCavities below). Tested as the cavity it is: where the teeth of its gears mesh
     // they stand 0.11 to 0.15 mm apart, die walls that the field keeps. (As a tool those gaps are
     // free space narrower than a voxel, where its wall query errs by up to 2 voxels: docs/MESHES.md.)
-    {"planetary_gearset_vtk_gears.stl", mesh::LengthUnit::mm, nullptr, 0.714, mesh::WallRole::cavity},
+    {"planetary_gearset_vtk_gears.stl", geometry::LengthUnit::mm, nullptr, 0.714, mesh::WallRole::cavity},
     // 100 overlapping shells: 24·10⁹ winding-number terms at cells of 0.125 mm, and it is refused.
     // At voxels of 0.9 mm it loads as a tool (472 s) and is refused as a cavity (docs/MESHES.md, "Shared
     // dies through the pipeline").
-    {"toothed_pulley_hub_trimesh_cycloidal.ply", mesh::LengthUnit::in, "non-manifold edges"},
+    {"toothed_pulley_hub_trimesh_cycloidal.ply", geometry::LengthUnit::in, "non-manifold edges"},
     // One part of it, as a die is for one part (docs/MESHES.md, "Assemblies"): its 4th largest body, a
     // cycloid disc (43.4 mm across, 3.18 mm thick, lobed, 7 bores), as the cavity it would be.
-    {"toothed_pulley_hub_trimesh_cycloidal.ply", mesh::LengthUnit::in, nullptr, 0.15, mesh::WallRole::cavity, 4},
+    {"toothed_pulley_hub_trimesh_cycloidal.ply", geometry::LengthUnit::in, nullptr, 0.15, mesh::WallRole::cavity, 4},
     // 24 crossing shells: as a tool its winding-number solid closes the gaps between them that
     // no grain a voxel across touches, and it loads (as a cavity it has no flat opening).
-    {"broken/assimp_3DSMaxExport.stl", mesh::LengthUnit::mm, nullptr},
-    {"broken/assimp_Spider_ascii.stl", mesh::LengthUnit::mm, "boundary edges"},
-    {"broken/assimp_sphereWithHole.stl", mesh::LengthUnit::mm, nullptr},  // winding number
-    {"broken/assimp_triangle_with_two_solids.stl", mesh::LengthUnit::mm, "cannot enclose a solid"},
-    {"broken/numpystl_StarWithEmptyHeader.stl", mesh::LengthUnit::mm, nullptr},
-    {"broken/trimesh_featuretype_badheader_open.stl", mesh::LengthUnit::in, "boundary edges"},
-    {"broken/trimesh_soup.stl", mesh::LengthUnit::mm, "boundary edges"},
-    {"broken/trimesh_stl_empty_ascii.stl", mesh::LengthUnit::mm, "not a readable mesh"},
-    {"broken/trimesh_stl_empty_bin.stl", mesh::LengthUnit::mm, "not a readable mesh"},
+    {"broken/assimp_3DSMaxExport.stl", geometry::LengthUnit::mm, nullptr},
+    {"broken/assimp_Spider_ascii.stl", geometry::LengthUnit::mm, "boundary edges"},
+    {"broken/assimp_sphereWithHole.stl", geometry::LengthUnit::mm, nullptr},  // winding number
+    {"broken/assimp_triangle_with_two_solids.stl", geometry::LengthUnit::mm, "cannot enclose a solid"},
+    {"broken/numpystl_StarWithEmptyHeader.stl", geometry::LengthUnit::mm, nullptr},
+    {"broken/trimesh_featuretype_badheader_open.stl", geometry::LengthUnit::in, "boundary edges"},
+    {"broken/trimesh_soup.stl", geometry::LengthUnit::mm, "boundary edges"},
+    {"broken/trimesh_stl_empty_ascii.stl", geometry::LengthUnit::mm, "not a readable mesh"},
+    {"broken/trimesh_stl_empty_bin.stl", geometry::LengthUnit::mm, "not a readable mesh"},
 };
 
 void PrintTo(const SharedDie& d, std::ostream* os) { *os << d.file; }
@@ -72,19 +72,19 @@ void PrintTo(const SharedDie& d, std::ostream* os) { *os << d.file; }
 // A cavity's field is negative in the die around it: below the table, outside the part (the
 // file turned to open upward, as the die is); there points within a voxel of the table, or
 // below the part's floor where the die's bottom may be near, are not checked.
-void expect_sign_of_the_file(const std::filesystem::path& path, mesh::LengthUnit unit, mesh::WallRole role,
+void expect_sign_of_the_file(const std::filesystem::path& path, geometry::LengthUnit unit, mesh::WallRole role,
                              const mesh::PreparedDie& die, double voxel) {
   const bool cavity = role == mesh::WallRole::cavity;
-  const mesh::TriMesh file = cavity ? mesh::read_die_file(path, unit, die.up, mesh::Parting::automatic, die.part).mesh
-                                    : mesh::import_mesh(path, {unit}).mesh;
+  const geometry::TriMesh file = cavity ? mesh::read_die_file(path, unit, die.up, mesh::Parting::automatic, die.part).mesh
+                                        : mesh::import_mesh(path, {unit}).mesh;
   const mesh::ExactSurface rays(file);
-  const mesh::Box box = mesh::bounding_box(file);
-  const mesh::Vec3 margin = 0.1 * box.size();
+  const geometry::Box box = geometry::bounding_box(file);
+  const geometry::Vec3 margin = 0.1 * box.size();
   std::mt19937_64 random(19);
   std::uniform_real_distribution<double> unit_interval;
   std::size_t checked = 0, agree = 0, inside = 0;
   while (checked < 100000) {
-    const mesh::Vec3 p = box.lo - margin + mesh::Vec3(unit_interval(random), unit_interval(random), unit_interval(random))
+    const geometry::Vec3 p = box.lo - margin + geometry::Vec3(unit_interval(random), unit_interval(random), unit_interval(random))
                                                 .cwiseProduct(box.size() + 2 * margin);
     if (rays.distance(p) <= voxel) continue;
     if (cavity && (p.z() < box.lo.z() || p.z() > die.table_z - voxel)) continue;
@@ -112,7 +112,7 @@ TEST_P(SharedDieMesh, LoadsAndPassesTheSignCheckOrNamesItsDefect) {
   if (voxel == 0) {
     voxel = 0.125e-3;
     try {
-      voxel = std::max(voxel, mesh::bounding_box(mesh::import_mesh(path, {d.unit}).mesh).size().maxCoeff() / 300);
+      voxel = std::max(voxel, geometry::bounding_box(mesh::import_mesh(path, {d.unit}).mesh).size().maxCoeff() / 300);
     } catch (const diefill::InputError&) {
       // prepare_die below reports it
     }
@@ -165,7 +165,7 @@ TEST(SharedDieUnits, AreGuessedAsTheSourcesJudgeThem) {
   for (const SharedDie& d : shared_dies) {
     if (std::string_view(d.file).starts_with("broken/")) continue;
     const mesh::ImportResult r = mesh::import_mesh(test::shared_meshes() / "dies" / d.file, {std::nullopt});
-    EXPECT_EQ(mesh::unit_name(r.unit), mesh::unit_name(d.unit)) << d.file;
+    EXPECT_EQ(geometry::unit_name(r.unit), geometry::unit_name(d.unit)) << d.file;
   }
 }
 
@@ -174,11 +174,11 @@ TEST(SharedDieUnits, AreGuessedAsTheSourcesJudgeThem) {
 // flat face (-y: 235 mm² against 181) and the flange plate's face (-z).
 TEST(SharedDieOpenings, AreTheFacesThatOpenTheOutline) {
   REQUIRE_SHARED_MESHES();
-  const auto opening = [](const char* file, mesh::LengthUnit unit) {
+  const auto opening = [](const char* file, geometry::LengthUnit unit) {
     return mesh::read_die_file(test::shared_meshes() / "dies" / file, unit, std::nullopt).up;
   };
-  EXPECT_EQ(mesh::up_name(opening("gear_8tooth_open_thingi10k_50736.stl", mesh::LengthUnit::mm)), "-y");
-  EXPECT_EQ(mesh::up_name(opening("flanged_ring_trimesh_idler_riser.stl", mesh::LengthUnit::in)), "-z");
+  EXPECT_EQ(mesh::up_name(opening("gear_8tooth_open_thingi10k_50736.stl", geometry::LengthUnit::mm)), "-y");
+  EXPECT_EQ(mesh::up_name(opening("flanged_ring_trimesh_idler_riser.stl", geometry::LengthUnit::in)), "-z");
 }
 
 // The planetary gear set's ring gear folds through itself where its profile's two ends meet: 98
@@ -191,7 +191,7 @@ TEST(SharedDieOpenings, AreTheFacesThatOpenTheOutline) {
 TEST(SharedDieCavities, APlanetaryGearSetsSeamFoldsAreWeldedAndItsGearsStayApart) {
   REQUIRE_SHARED_MESHES();
   const mesh::DieFile file =
-      mesh::read_die_file(test::shared_meshes() / "dies" / "planetary_gearset_vtk_gears.stl", mesh::LengthUnit::mm, std::nullopt);
+      mesh::read_die_file(test::shared_meshes() / "dies" / "planetary_gearset_vtk_gears.stl", geometry::LengthUnit::mm, std::nullopt);
   EXPECT_EQ(mesh::up_name(file.up), "+z");
   const mesh::RepairOptions o = mesh::die_options_for_grains(0.65e-3, 0.25e-3, 0.714e-3).repair;
   const mesh::RepairResult r = mesh::repair(file.mesh, o, file.source);
@@ -201,7 +201,7 @@ TEST(SharedDieCavities, APlanetaryGearSetsSeamFoldsAreWeldedAndItsGearsStayApart
   ASSERT_EQ(r.actions.size(), 1u);
   EXPECT_NE(r.actions.front().find("welded"), std::string::npos) << r.actions.front();
   EXPECT_LE(r.hausdorff_m, 1e-3 * o.tolerance_m);
-  const double volume = mesh::signed_volume(file.mesh);
+  const double volume = geometry::signed_volume(file.mesh);
   EXPECT_NEAR(r.after.volume_m3, volume, 1e-6 * volume);
 }
 
@@ -215,12 +215,12 @@ TEST(WallQuery, MinimaOfBothSignsWidenTheSearchToTheTrueClosestTriangle) {
   o.role = mesh::WallRole::tool;
   const mesh::PreparedDie die =
       mesh::prepare_die(test::shared_meshes() / "dies" / "blind_flange_disc_trimesh_counter_mm.stl", o, std::nullopt);
-  const mesh::WallField field = die.sdf.wall_field(die.solid);
+  const geometry::WallField field = die.sdf.wall_field(die.solid);
   const mesh::ExactSurface exact(die.solid);
-  const mesh::Vec3 p(174.9516e-3, 204.3411e-3, 279.0145e-3);
+  const geometry::Vec3 p(174.9516e-3, 204.3411e-3, 279.0145e-3);
   EXPECT_NEAR(exact.signed_distance(p), -0.5277e-3, 1e-7);
   EXPECT_NEAR(field.signed_distance(p), exact.signed_distance(p), 1e-12);
-  mesh::SurfacePoint contacts[4];
+  geometry::SurfacePoint contacts[4];
   const int n = field.local_minima(p, 1e-3, contacts, 4);
   ASSERT_GT(n, 0);
   for (int k = 0; k < n; ++k) EXPECT_LT(contacts[k].distance, 0) << "a point inside is inside for every contact";
@@ -236,13 +236,13 @@ TEST(WallQuery, APointBesideASheetThinnerThanAVoxelIsOutside) {
   mesh::DieOptions o = mesh::die_options_for_grains(0.5e-3, 0.25e-3, 0.2e-3);
   const mesh::PreparedDie die =
       mesh::prepare_die(test::shared_meshes() / "dies" / "blind_flange_disc_trimesh_counter_mm.stl", o, std::nullopt);
-  const mesh::WallField field = die.sdf.wall_field(die.solid);
+  const geometry::WallField field = die.sdf.wall_field(die.solid);
   const mesh::ExactSurface exact(die.solid);
-  for (const mesh::Vec3& p : {mesh::Vec3(-44.6740e-3, 46.9778e-3, 279.1630e-3), mesh::Vec3(119.6250e-3, 40.9364e-3, 280.5783e-3)}) {
+  for (const geometry::Vec3& p : {geometry::Vec3(-44.6740e-3, 46.9778e-3, 279.1630e-3), geometry::Vec3(119.6250e-3, 40.9364e-3, 280.5783e-3)}) {
     const double truth = exact.signed_distance(p);
     ASSERT_GT(truth, 0.5 * field.voxel) << p.transpose() * 1e3;
     EXPECT_NEAR(field.signed_distance(p), truth, 0.01 * field.voxel) << p.transpose() * 1e3;
-    mesh::SurfacePoint contacts[4];
+    geometry::SurfacePoint contacts[4];
     const int n = field.local_minima(p, 0.5e-3, contacts, 4);
     ASSERT_GT(n, 0);
     for (int k = 0; k < n; ++k) EXPECT_GT(contacts[k].distance, 0) << "every contact of a point outside is outside";

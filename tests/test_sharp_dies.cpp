@@ -41,8 +41,8 @@ TEST_P(SharpFeatureDie, FillsWithNoGrainInsideTheDieSolid) {
   const SharpDie& d = GetParam();
   const fs::path dir = test::suite_folder("sharp_dies") / d.name;
   fs::create_directories(dir);
-  const mesh::TriMesh cavity = mesh::bundled_die(d.name);
-  mesh::write_stl(cavity, dir / (std::string(d.name) + ".stl"), mesh::LengthUnit::mm, std::string("diefill ") + d.name + " cavity, mm");
+  const geometry::TriMesh cavity = mesh::bundled_die(d.name);
+  mesh::write_stl(cavity, dir / (std::string(d.name) + ".stl"), geometry::LengthUnit::mm, std::string("diefill ") + d.name + " cavity, mm");
   scene::PipelineScene scene = scene::load_pipeline_scene(
       std::nullopt, {fmt::format("powder.coarse_graining={}", d.coarse_graining), "output.snapshot_every=0.05",
                      "output.directory=" + (dir / "out").string()});

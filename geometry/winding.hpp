@@ -9,9 +9,9 @@
 // dipole (their area vector at their area centroid); near triangles are summed exactly.
 #include <vector>
 
-#include "mesh/trimesh.hpp"
+#include "geometry/trimesh.hpp"
 
-namespace mesh {
+namespace geometry {
 
 // Signed solid angle of triangle (a, b, c) seen from p [sr], positive when p lies behind the
 // triangle's counter-clockwise face (Van Oosterom & Strackee 1983).
@@ -48,4 +48,4 @@ class WindingNumber {
   double accuracy_;
 };
 
-}  // namespace mesh
+}  // namespace geometry

@@ -1,10 +1,10 @@
-#include "mesh/wall_field.hpp"
+#include "geometry/wall_field.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <map>
 
-namespace mesh {
+namespace geometry {
 
 ClosestPoint closest_feature(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   // Ericson, Real-Time Collision Detection §5.1.5, keeping track of the Voronoi region.
@@ -399,4 +399,4 @@ double WallField::signed_distance(const Vec3& p) const {
   return nearest(p, 0, best) ? best.distance : trilinear(p);
 }
 
-}  // namespace mesh
+}  // namespace geometry

@@ -15,9 +15,9 @@
 #include <vector>
 
 #include "core/huge_pages.hpp"
-#include "mesh/trimesh.hpp"
+#include "geometry/trimesh.hpp"
 
-namespace mesh {
+namespace geometry {
 
 // Where on a triangle a closest point lies.
 enum class Feature : std::uint8_t { face, edge, vertex };
@@ -148,4 +148,4 @@ struct WallField {
   static int merged_minima(SurfacePoint* minima, int n, double range, SurfacePoint* out, int capacity);
 };
 
-}  // namespace mesh
+}  // namespace geometry

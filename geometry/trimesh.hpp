@@ -9,7 +9,9 @@
 #include <string_view>
 #include <vector>
 
-namespace mesh {
+#include "core/choice.hpp"
+
+namespace geometry {
 
 using Vec3 = Eigen::Vector3d;
 using Triangle = std::array<int, 3>;
@@ -45,8 +47,10 @@ std::vector<std::array<double, 4>> plane_section(const TriMesh& mesh, int axis, 
 
 // Length units a mesh file may declare (files store none).
 enum class LengthUnit { mm, m, in };
+inline constexpr std::array<diefill::Choice<LengthUnit>, 3> length_units = {
+    {{"mm", LengthUnit::mm}, {"m", LengthUnit::m}, {"in", LengthUnit::in}}};
 double metres_per_unit(LengthUnit unit);
-std::string_view unit_name(LengthUnit unit);
+inline std::string_view unit_name(LengthUnit unit) { return diefill::choice_name(length_units, unit); }
 // Throws diefill::InputError naming `field` when `text` is not mm, m or in.
 LengthUnit parse_unit(std::string_view text, std::string_view field);
 // As parse_unit, and "auto": no unit given, to be guessed from the mesh's size (guess_unit).
@@ -56,4 +60,4 @@ std::optional<LengthUnit> parse_unit_or_auto(std::string_view text, std::string_
 // inches (25-76 mm: a part a few inches across); less than 1 as metres (a part under a metre).
 LengthUnit guess_unit(double extent_in_file_units);
 
-}  // namespace mesh
+}  // namespace geometry

@@ -1,10 +1,10 @@
-#include "mesh/winding.hpp"
+#include "geometry/winding.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 
-namespace mesh {
+namespace geometry {
 
 namespace {
 constexpr int leaf_size = 8;
@@ -120,4 +120,4 @@ std::size_t WindingNumber::terms(const Vec3& p) const {
   return terms;
 }
 
-}  // namespace mesh
+}  // namespace geometry

@@ -2,9 +2,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "mesh/tetmesh.hpp"
+#include "geometry/tetmesh.hpp"
 
-namespace mesh {
+namespace geometry {
 
 double tet_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   return (b - a).cross(c - a).dot(d - a) / 6.0;
@@ -62,4 +62,4 @@ TetQuality tet_quality(const TetMesh& m) {
   return q;
 }
 
-}  // namespace mesh
+}  // namespace geometry

@@ -6,9 +6,9 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "mesh/trimesh.hpp"
+#include "geometry/trimesh.hpp"
 
-namespace mesh {
+namespace geometry {
 
 struct ClumpSphere {
   Vec3 centre;    // [m], principal frame
@@ -38,4 +38,4 @@ struct ClumpTemplate {
   std::vector<ClumpStep> history;      // one entry per sphere added
 };
 
-}  // namespace mesh
+}  // namespace geometry

@@ -1,9 +1,9 @@
-#include "mesh/trimesh.hpp"
+#include "geometry/trimesh.hpp"
 
 #include "core/error.hpp"
-#include "mesh/versions.hpp"
+#include "geometry/versions.hpp"
 
-namespace mesh {
+namespace geometry {
 
 Box bounding_box(const TriMesh& mesh) {
   Box box;
@@ -81,21 +81,12 @@ double metres_per_unit(LengthUnit unit) {
   return 1.0;
 }
 
-std::string_view unit_name(LengthUnit unit) {
-  switch (unit) {
-    case LengthUnit::mm: return "mm";
-    case LengthUnit::m: return "m";
-    case LengthUnit::in: return "in";
-  }
-  return "?";
-}
 
 LengthUnit parse_unit(std::string_view text, std::string_view field) {
-  if (text == "mm") return LengthUnit::mm;
-  if (text == "m") return LengthUnit::m;
-  if (text == "in" || text == "inch") return LengthUnit::in;
+  if (text == "inch") return LengthUnit::in;
+  if (const auto unit = diefill::find_choice(length_units, text)) return *unit;
   throw diefill::InputError("", std::string(field), "unknown length unit '" + std::string(text) + "'",
-                            "Use mm, m or in");
+                            "Use " + diefill::choice_list(length_units));
 }
 
 std::optional<LengthUnit> parse_unit_or_auto(std::string_view text, std::string_view field) {
@@ -114,11 +105,9 @@ LengthUnit guess_unit(double extent_in_file_units) {
   return LengthUnit::m;
 }
 
-}  // namespace mesh
-
-namespace mesh {
 std::string eigen_version() {
   return std::to_string(EIGEN_WORLD_VERSION) + "." + std::to_string(EIGEN_MAJOR_VERSION) + "." +
          std::to_string(EIGEN_MINOR_VERSION);
 }
-}  // namespace mesh
+
+}  // namespace geometry
