@@ -21,4 +21,10 @@ struct ClumpRequest {
 // Throws InputError for a mesh that cannot be repaired or a tolerance the spheres cannot meet.
 geometry::ClumpTemplate build_clump(const ClumpRequest& request);
 
+// `diefill clump`'s outputs: the template (JSON) at `out` when it ends in .json, else in the
+// folder `out` named after the mesh; beside it NAME_errors.csv, the errors and the relative cost
+// of a step against the number of spheres, and its chart. Returns the template's path.
+std::filesystem::path write_clump_outputs(const geometry::ClumpTemplate& clump, const std::filesystem::path& mesh,
+                                          const std::filesystem::path& out);
+
 }  // namespace pipeline
