@@ -275,9 +275,7 @@ bool needs_rebuild(const Model& model, const State& s, double largest_shift2) {
   return std::sqrt(largest_shift2) + wall_shift > 0.5 * model.skin;
 }
 
-void rebuild_neighbours(const Model& model, State& s) {
-  // Particles outside the domain are lost: counted, frozen, never silently dropped. A clump is
-  // lost whole, when its centre leaves.
+void lose_outside_domain(const Model& model, State& s) {
   auto lose = [&s](std::size_t i) {
     s.active[i] = 0;
     s.v[i].setZero();
@@ -295,6 +293,10 @@ void rebuild_neighbours(const Model& model, State& s) {
       for (std::int32_t k = bodies.member_start[b]; k < bodies.member_start[b + 1]; ++k)
         lose(std::size_t(bodies.member[std::size_t(k)]));
     }
+}
+
+void rebuild_neighbours(const Model& model, State& s) {
+  lose_outside_domain(model, s);
 
   // The old pairs' histories come from the list (or, split over ranks, with the grains, by global
   // id: exchange.hpp), matched to the new list's pairs below.

@@ -10,7 +10,10 @@ namespace dem {
 
 // `largest_shift2`: the largest squared displacement of a grain since the last build [m²].
 bool needs_rebuild(const Model& model, const State& state, double largest_shift2);
-// Marks particles outside the domain as lost, re-sorts, rebuilds the list, carries history.
+// Marks this rank's grains outside the domain as lost: counted, frozen, never silently dropped
+// (a clump whole, when its centre leaves).
+void lose_outside_domain(const Model& model, State& state);
+// Loses the grains outside the domain, re-sorts, rebuilds the list, carries history.
 void rebuild_neighbours(const Model& model, State& state);
 
 }  // namespace dem
