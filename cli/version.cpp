@@ -2,7 +2,7 @@
 
 #include "cli/commands.hpp"
 #include "core/resources.hpp"
-#include "geometry/versions.hpp"
+#include "geometry/eigen_version.hpp"
 #include "mesh/versions.hpp"
 
 namespace cli {

@@ -1,7 +1,6 @@
 #include "geometry/trimesh.hpp"
 
 #include "core/error.hpp"
-#include "geometry/versions.hpp"
 
 namespace geometry {
 
@@ -103,11 +102,6 @@ LengthUnit guess_unit(double extent_in_file_units) {
   if (extent_in_file_units >= 3.0) return LengthUnit::mm;
   if (extent_in_file_units >= 1.0) return LengthUnit::in;
   return LengthUnit::m;
-}
-
-std::string eigen_version() {
-  return std::to_string(EIGEN_WORLD_VERSION) + "." + std::to_string(EIGEN_MAJOR_VERSION) + "." +
-         std::to_string(EIGEN_MINOR_VERSION);
 }
 
 }  // namespace geometry

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "core/child_process.hpp"
-#include "geometry/tetmesh.hpp"
+#include "geometry/tet_mesh.hpp"
 
 namespace mesh {
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "geometry/tetmesh.hpp"
+#include "geometry/tet_mesh.hpp"
 #include "postprocess/density.hpp"
 
 namespace post {

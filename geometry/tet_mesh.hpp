@@ -1,5 +1,5 @@
 #pragma once
-// A tetrahedral mesh as plain data, and the measures of its quality (tet_quality.cpp): what the
+// A tetrahedral mesh as plain data, and the measures of its quality (tet_mesh.cpp): what the
 // FEM hand-off passes to postprocess, which links no CGAL. mesh/tetmesh.hpp makes one (CGAL
 // Mesh_3).
 #include <array>

@@ -2,7 +2,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "geometry/tetmesh.hpp"
+#include "geometry/tet_mesh.hpp"
 
 namespace geometry {
 

@@ -1,6 +1,6 @@
 #pragma once
 // The version of Eigen the geometry module was built with, for `diefill --version` (beside
-// mesh/versions.hpp's libraries); defined in trimesh.cpp.
+// mesh/versions.hpp's libraries).
 #include <string>
 
 namespace geometry {
