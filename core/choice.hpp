@@ -7,6 +7,8 @@
 #include <string>
 #include <string_view>
 
+#include "core/error.hpp"
+
 namespace diefill {
 
 template <class Value>
@@ -35,6 +37,14 @@ std::string choice_list(const std::array<Choice<Value>, N>& table) {
   std::string list;
   for (std::size_t k = 0; k < N; ++k) list += (k == 0 ? "" : k + 1 == N ? " or " : ", ") + std::string(table[k].name);
   return list;
+}
+
+// The value named `text` in a choice's table; InputError naming `field` (a flag or a key) when it
+// names none.
+template <class Value, std::size_t N>
+Value parse_choice(const std::array<Choice<Value>, N>& table, std::string_view text, std::string_view field) {
+  if (const auto value = find_choice(table, text)) return *value;
+  throw InputError("", std::string(field), "'" + std::string(text) + "' is not one of its choices", "Use " + choice_list(table));
 }
 
 }  // namespace diefill

@@ -80,7 +80,6 @@ double metres_per_unit(LengthUnit unit) {
   return 1.0;
 }
 
-
 LengthUnit parse_unit(std::string_view text, std::string_view field) {
   if (text == "inch") return LengthUnit::in;
   if (const auto unit = diefill::find_choice(length_units, text)) return *unit;
@@ -94,7 +93,7 @@ std::optional<LengthUnit> parse_unit_or_auto(std::string_view text, std::string_
     return parse_unit(text, field);
   } catch (const diefill::InputError&) {
     throw diefill::InputError("", std::string(field), "unknown length unit '" + std::string(text) + "'",
-                              "Use mm, m, in, or auto (guessed from the mesh's size)");
+                              "Use " + diefill::choice_list(length_units) + ", or auto (guessed from the mesh's size)");
   }
 }
 

@@ -18,7 +18,7 @@ namespace pipeline {
 int particle_density(const ParticleDensityRequest& r) {
   const std::optional<geometry::LengthUnit> unit = geometry::parse_unit_or_auto(r.units, "--units");
   const mesh::WallRole role = mesh::parse_role(r.role, "--role");
-  const scene::DensityMethod method = scene::parse_choice(scene::density_methods, r.method, "--method");
+  const scene::DensityMethod method = diefill::parse_choice(scene::density_methods, r.method, "--method");
   if (role == mesh::WallRole::tool)
     throw diefill::InputError(r.die.string(), "--role", "a density field needs the cavity, not the tool body",
                               "Give the cavity mesh (role cavity) or a container");

@@ -3,11 +3,8 @@
 // read once from the scene's text (scene/pipeline_scene.cpp) or a command's flag, and acted on by
 // the stage.
 #include <array>
-#include <string>
-#include <string_view>
 
 #include "core/choice.hpp"
-#include "core/error.hpp"
 
 namespace scene {
 
@@ -25,14 +22,5 @@ inline constexpr std::array<diefill::Choice<FemElements>, 3> fem_element_kinds =
 enum class FemCompaction { calculix, none };
 inline constexpr std::array<diefill::Choice<FemCompaction>, 2> fem_compactions = {
     {{"calculix", FemCompaction::calculix}, {"none", FemCompaction::none}}};
-
-// The value named `text` in a choice's table; InputError naming `field` (a flag or a key) when it
-// names none.
-template <class Value, std::size_t N>
-Value parse_choice(const std::array<diefill::Choice<Value>, N>& table, std::string_view text, std::string_view field) {
-  if (const auto value = diefill::find_choice(table, text)) return *value;
-  throw diefill::InputError("", std::string(field), "'" + std::string(text) + "' is not one of its choices",
-                            "Use " + diefill::choice_list(table));
-}
 
 }  // namespace scene

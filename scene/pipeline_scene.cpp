@@ -104,16 +104,17 @@ KeyTable<P> make_pipeline_keys() {
              "flat faces cover the largest share of the outline along their axis",
              member(&P::die, &DieSettings::up)),
       choice("die", "parting", options_of(mesh::partings), die,
-                            "where the die table meets the part: opening, at its flat face (a part with none is refused); widest, at "
-                            "its widest section across the up axis, the cavity being the part below (the upper punch forms the "
-                            "rest); auto: opening when the part has a flat face at an extreme, else widest with the part lying flat "
-                            "(up: the axis of its largest outline)",
-                            member(&P::die, &DieSettings::parting)),
+             "where the die table meets the part: opening, at its flat face (a part with none is refused); widest, at "
+             "its widest section across the up axis, the cavity being the part below (the upper punch forms the "
+             "rest); auto: opening when the part has a flat face at an extreme, else widest with the part lying flat "
+             "(up: the axis of its largest outline)",
+             member(&P::die, &DieSettings::parting)),
       integer("die", "part", {0, 1e6}, die,
               "for a file that holds an assembly (bodies that share no vertex): the body the die is for, numbered by "
               "enclosed volume, largest first; 0: the whole file as one part",
               member(&P::die, &DieSettings::part)),
-      choice<mesh::WallRole>("die", "role", {{"cavity", mesh::WallRole::cavity}}, die,  // the pipeline fills a cavity
+      // Of the wall roles, the pipeline fills a cavity only.
+      choice<mesh::WallRole>("die", "role", {{"cavity", mesh::WallRole::cavity}}, die,
                              "the mesh is the part's shape, open at the die table (its highest z); `diefill sdf --role` takes tools too",
                              member(&P::die, &DieSettings::role)),
       number("die", "voxel_fraction", "largest grain radii", {0.05, 4}, die,
@@ -159,7 +160,7 @@ KeyTable<P> make_pipeline_keys() {
       number("powder.shape", "tolerance", "", {0.01, 0.5}, settling, "the clump's volume and Hausdorff error",
              member(&P::powder, &PowderSettings::shape_tolerance)),
       choice("powder.shape", "units", options_of(geometry::length_units), settling, "the grain mesh's length unit",
-                                   member(&P::powder, &PowderSettings::shape_units)),
+             member(&P::powder, &PowderSettings::shape_units)),
   };
   add_physics_keys<P>(k, spec_of, settling);
   const auto physics_end = std::stable_partition(k.begin(), k.end(), [](const K& key) { return key.table != "simulation"; });
@@ -170,15 +171,15 @@ KeyTable<P> make_pipeline_keys() {
   k.push_back(integer("simulation", "threads", {0, 4096}, nothing, "0: all cores; results do not depend on it", member(&P::threads)));
   k.push_back(number("density", "voxel", "m", zero_or(1e-5, 0.05), run, "0: two grain diameters", member(&P::density, &DensitySettings::voxel)));
   k.push_back(choice("density", "method", options_of(density_methods), run,
-                   "exact volume split, or Gaussian coarse graining", member(&P::density, &DensitySettings::method)));
+                     "exact volume split, or Gaussian coarse graining", member(&P::density, &DensitySettings::method)));
   k.push_back(number("density", "smoothed_width", "m", zero_or(1e-5, 0.05), run,
                      "the smoothed field's Gaussian width and voxel; 0: half a grain diameter", member(&P::density, &DensitySettings::smoothed_width)));
   k.push_back(number("fem", "element_size", "m", zero_or(1e-4, 0.05), run,
                      "the tetrahedra's largest edge in fem/fill.inp; 0: the density voxel", member(&P::fem, &FemSettings::element_size)));
   k.push_back(choice("fem", "elements", options_of(fem_element_kinds), run,
-                   "C3D4, C3D10 with a node on every edge, or none: no FEM hand-off", member(&P::fem, &FemSettings::elements)));
+                     "C3D4, C3D10 with a node on every edge, or none: no FEM hand-off", member(&P::fem, &FemSettings::elements)));
   k.push_back(choice("fem", "compaction", options_of(fem_compactions), run,
-                   "the worked example: the fill pressed by a punch in CalculiX (fem/compaction.*)", member(&P::fem, &FemSettings::compaction)));
+                     "the worked example: the fill pressed by a punch in CalculiX (fem/compaction.*)", member(&P::fem, &FemSettings::compaction)));
   k.push_back(text("output", "directory", KeyType::text, nothing, "each die writes into DIRECTORY/<die name>/ (relative "
                    "to the working folder)", member(&P::output, &OutputSettings::directory)));
   k.push_back(text("output", "cache", KeyType::text, nothing, "prepared die fields and settled shoes, reused by runs "
