@@ -6,6 +6,7 @@
 #include <omp.h>
 
 #include <fstream>
+#include <numeric>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
@@ -222,66 +223,121 @@ std::pair<dem::Model, dem::State> ring_pack(std::size_t count, const fs::path& c
   return {dem::compile_model(spec, fresh, "bench"), fresh};
 }
 
-// The scaling case: dense beds of `count` grains cut from the settled LIGGGHTS pack (the grains
-// wholly inside a square column of it, so that none overlaps the column's walls; one column per
-// tile, tiles side by side a grain apart in a box of planes), so that every size is the same
-// powder, and no hour-long pour is needed for half a million grains. Tiles hold the column's grains
-// lowest first. A bed smaller than one tile is a narrower square of the column. Cut out so, a bed
-// is not at rest (settled_bed).
-std::pair<dem::Model, dem::State> tiled_pack(const dem::State& source, std::size_t count) {
-  constexpr double column = 30e-3;  // the largest square the 44 mm cylinder holds, nearly
-  std::vector<std::size_t> in_column;
-  for (std::size_t i = 0; i < source.size(); ++i)
-    if (std::max(std::abs(source.x[i].x()), std::abs(source.x[i].y())) + source.radius[i] < 0.5 * column) in_column.push_back(i);
-  std::sort(in_column.begin(), in_column.end(), [&](std::size_t a, std::size_t b) { return source.x[a].z() < source.x[b].z(); });
-  const std::size_t per_tile = in_column.size();
-  const std::size_t tiles = (count + per_tile - 1) / per_tile;
-  const int side = int(std::ceil(std::sqrt(double(tiles))));
-  const double pitch = column + 1e-3, z0 = source.x[in_column.front()].z() - source.radius[in_column.front()];
-  // A single tile smaller than the column: the square of the same height that holds `count`.
-  const double shrink = tiles == 1 ? std::sqrt(double(count) / double(per_tile)) : 1.0;
-  dem::State s;
-  for (std::size_t t = 0; t < tiles && s.size() < count; ++t) {
-    const dem::Vec3 shift(double(int(t) % side) * pitch, double(int(t) / side) * pitch, -z0);
-    for (std::size_t i : in_column) {
-      if (s.size() == count) break;
-      if (shrink < 1 && std::max(std::abs(source.x[i].x()), std::abs(source.x[i].y())) + source.radius[i] > 0.5 * column * shrink) continue;
-      s.add_sphere(std::int64_t(s.size()), source.x[i] + shift, source.radius[i], 2500, 0);
-    }
-  }
+// The scaling case: beds of 5k to 500k grains made of tiles cut from the settled LIGGGHTS pack,
+// so that every size is the same powder and no hour-long pour is needed for half a million grains.
+// A tile is the lowest grains wholly inside a square column of the pack (none overlaps the tile's
+// walls); a bed of several tiles holds equal tiles side by side, filling a rectangle in one box of
+// planes; a bed smaller than the column is a narrower square of the column's height. Cut out so, a
+// tile has lost the grains that pressed on it (above, or beside it in the cylinder): it springs
+// apart and falls back for tens of milliseconds, and timed so, its contacts fall (4.4 to 0.45-2.75
+// per grain in 2,000 steps) and fewer contacts make a faster step: the sizes would not be like for
+// like (docs/PERFORMANCE.md, "Against the grain count"). So a tile is settled alone, the bed is
+// laid out of mirrored copies of the settled tile with its contact histories, and settled again where the
+// copies meet (settled_bed).
+constexpr double pack_column = 30e-3;  // the largest square the 44 mm cylinder holds, nearly
+
+struct Bed {
+  dem::Model model;
+  dem::State grains;
+};
+
+// The reference scene's law in a box of planes (a floor, four sides) around `across` x `along`
+// squares of side `side`, the first centred on the z axis, the floor at z = 0.
+dem::Model boxed_model(const dem::State& grains, double side, int across, int along) {
   dem::ModelSpec spec = reference_spec();
   spec.gravity = dem::Vec3(0, 0, -9.81);
-  const double lo = -0.5 * column * shrink, hi_x = lo + double(std::min<int>(side, int(tiles)) - 1) * pitch + column * shrink;
-  const double hi_y = lo + double((int(tiles) + side - 1) / side - 1) * pitch + column * shrink;
+  const double lo = -0.5 * side, hi_x = lo + across * side, hi_y = lo + along * side;
   spec.planes = {{dem::Vec3(0, 0, 0), dem::Vec3::UnitZ(), 0, "floor"},
                  {dem::Vec3(lo, 0, 0), dem::Vec3::UnitX(), 0, "side"},
                  {dem::Vec3(hi_x, 0, 0), -dem::Vec3::UnitX(), 0, "side"},
                  {dem::Vec3(0, lo, 0), dem::Vec3::UnitY(), 0, "side"},
                  {dem::Vec3(0, hi_y, 0), -dem::Vec3::UnitY(), 0, "side"}};
   spec.domain = {dem::Vec3(lo, lo, 0) - dem::Vec3::Constant(2e-3), dem::Vec3(hi_x, hi_y, 0.1) + dem::Vec3::Constant(2e-3)};
-  return {dem::compile_model(spec, s, "bench scaling"), s};
+  return dem::compile_model(spec, grains, "bench scaling");
 }
 
-// A tiled bed has lost the grains that pressed on it (above, or beside it in the cylinder): it
-// springs apart and falls back for tens of milliseconds, and timed so, its contacts fall (4.4 to
-// 0.45-2.75 per grain in 2,000 steps) and fewer contacts make a faster step, so the sizes would
-// not be like for like (docs/PERFORMANCE.md, "Against the grain count"). The bed is stepped until
-// it rests by the LIGGGHTS preparation's own criterion (mean kinetic energy per grain below
-// 1e-12 J, ../shared/bench/liggghts/in/prep.in) and kept at `path` as a checkpoint, contact
-// histories included, so that the timed steps go on from a bed at rest. Made once per size, pack
-// and model (the path's hash); under MPI by rank 0 alone.
-dem::State settled_bed(const dem::Model& model, dem::State bed, const fs::path& path, const std::shared_ptr<dem::Exchange>& ranks) {
+// The grains of `source` wholly inside the centred square of side `side`, lowest first.
+std::vector<std::size_t> lowest_in_square(const dem::State& source, double side) {
+  std::vector<std::size_t> in_square;
+  for (std::size_t i = 0; i < source.size(); ++i)
+    if (std::max(std::abs(source.x[i].x()), std::abs(source.x[i].y())) + source.radius[i] < 0.5 * side) in_square.push_back(i);
+  std::sort(in_square.begin(), in_square.end(), [&](std::size_t a, std::size_t b) { return source.x[a].z() < source.x[b].z(); });
+  return in_square;
+}
+
+// One tile of `count` grains: the lowest of the pack's column, or with `narrow`, the narrower
+// square of the column's height that holds them; standing on the floor.
+Bed column_tile(const dem::State& source, std::size_t count, bool narrow) {
+  const std::size_t per_column = lowest_in_square(source, pack_column).size();
+  // The square holding `count` by area holds fewer wholly inside: widened until it holds them.
+  double side = narrow ? pack_column * std::sqrt(double(count) / double(per_column)) : pack_column;
+  while (side < pack_column && lowest_in_square(source, side).size() < count) side = std::min(pack_column, 1.01 * side);
+  const std::vector<std::size_t> lowest = lowest_in_square(source, side);
+  if (lowest.size() < count)
+    throw diefill::InputError("bench scaling", "--sizes", fmt::format("a tile of {} grains is more than the pack's column holds ({})", count, lowest.size()),
+                              "Use the 50k LIGGGHTS pack (bench/scaling.sh prepares it)");
+  const double z0 = source.x[lowest.front()].z() - source.radius[lowest.front()];
+  dem::State tile;
+  for (std::size_t k = 0; k < count; ++k)
+    tile.add_sphere(std::int64_t(k), source.x[lowest[k]] - dem::Vec3(0, 0, z0), source.radius[lowest[k]], 2500, 0);
+  return {boxed_model(tile, side, 1, 1), tile};
+}
+
+// `across` x `along` copies of the settled `tile` (side `side`) at a pitch of one tile, every other
+// one mirrored, each with the tile's contact histories. Across a seam a grain that leaned on the
+// tile's wall meets its own mirror image, which pushes it back as the wall did (twice as hard at the
+// same overlap, by Hertz, so the pair gives way by a third of a wall overlap, under a micrometre),
+// and their mirrored motions keep them from sliding on each other: the bed is laid out nearly at
+// rest. (Copies side by side unmirrored met grains where there had been holes, slid into them and
+// took 0.04-0.06 s to settle again at 50k-150k grains.)
+Bed tiled_bed(const dem::State& tile, double side, int across, int along) {
+  const dem::NeighbourList& listed = tile.neighbours;
+  if (listed.row_start.size() != tile.size() + 1) throw std::logic_error("bench scaling: a settled tile comes with its neighbour list");
+  dem::State bed;
+  dem::NeighbourList& nl = bed.neighbours;
+  nl.row_start.assign(1, 0);
+  for (int t = 0; t < across * along; ++t) {
+    // Mirrored in x and/or y: a vector's components flip, an axial vector's (angular velocity, a
+    // torque) flip where the others' do not, and flip all but z where both flip.
+    const int a = t % across, b = t / across;
+    const dem::Vec3 flip(a % 2 ? -1 : 1, b % 2 ? -1 : 1, 1), shift(a * side, b * side, 0);
+    const double handedness = flip.prod();
+    const auto place = [&](const dem::Vec3& v) -> dem::Vec3 { return v.cwiseProduct(flip); };
+    const auto turn = [&](const dem::Vec3& w) -> dem::Vec3 { return handedness * w.cwiseProduct(flip); };
+    const auto first = std::int32_t(bed.size());
+    for (std::size_t i = 0; i < tile.size(); ++i) {
+      bed.add_sphere(std::int64_t(bed.size()), place(tile.x[i]) + shift, tile.radius[i], 2500, 0, place(tile.v[i]), turn(tile.w[i]));
+      nl.row_start.push_back(nl.row_start.back() + listed.row_start[i + 1] - listed.row_start[i]);
+    }
+    for (const std::int32_t j : listed.partner) nl.partner.push_back(first + j);
+    for (const dem::Vec3& spring : listed.tangential) nl.tangential.push_back(place(spring));
+    for (const dem::Vec3& torque : listed.rolling) nl.rolling.push_back(turn(torque));
+  }
+  return {boxed_model(bed, side, across, along), bed};
+}
+
+// `bed` stepped until it rests by the LIGGGHTS preparation's own criterion (mean kinetic energy per
+// grain below 1e-12 J, ../shared/bench/liggghts/in/prep.in), kept at `path` as a checkpoint with its
+// contact histories, so that the timed steps go on from a bed at rest. Made once per bed (its
+// positions, histories and model are the file's hash) in `cache`; under MPI by rank 0 alone.
+dem::State settled_bed(const Bed& unsettled, const fs::path& cache, const std::string& name, const std::shared_ptr<dem::Exchange>& ranks) {
+  const dem::Model& model = unsettled.model;
+  const auto bytes = [](const auto& array) { return std::string_view(reinterpret_cast<const char*>(array.data()), array.size() * sizeof(array[0])); };
+  const std::string key = diefill::sha256_hex(model.hash + diefill::sha256_hex(bytes(unsettled.grains.x)) +
+                                              diefill::sha256_hex(bytes(unsettled.grains.neighbours.tangential)));
+  const fs::path path = cache / fmt::format("scaling_{}_{}.ckpt", name, key.substr(0, 16));
   if (!fs::exists(path) && (!ranks || ranks->rank() == 0)) {
     constexpr double at_rest_J = 1e-12, longest_s = 0.5;
     constexpr int steps_between_checks = 2000;
+    dem::State bed = unsettled.grains;
     const double grains = double(bed.size());
-    diefill::log::info("bench: settling the tiled bed of {} grains (once; kept in {})", bed.size(), path.string());
+    diefill::log::info("bench: settling a bed of {} grains (once; kept in {})", bed.size(), path.string());
     dem::initialize(model, bed);
-    for (double per_grain = dem::kinetic_energy(bed) / grains;;) {
+    for (;;) {
       for (int n = 0; n < steps_between_checks; ++n)
         if (const dem::StepReport report = dem::step(model, bed); report.status != dem::StepStatus::ok)
           throw diefill::StabilityError(fmt::format("bench scaling: settling {} grains: {}", bed.size(), report.message), model.dt);
-      per_grain = dem::kinetic_energy(bed) / grains;
+      const double per_grain = dem::kinetic_energy(bed) / grains;
       diefill::log::info("bench: {} grains at t = {:.3f} s: {:.2e} J per grain (at rest below {:.0e})", bed.size(), bed.time, per_grain, at_rest_J);
       if (per_grain < at_rest_J) break;
       if (bed.time > longest_s)
@@ -333,12 +389,25 @@ json run_cases(const Request& c, const std::shared_ptr<dem::Exchange>& ranks) {
         throw diefill::InputError("bench scaling", "--pack", "the scaling case tiles the settled LIGGGHTS pack",
                                   "Run bench/scaling.sh, which prepares it");
       const dem::State source = read_lammps_dump(c.pack, reference_material());
-      const std::string pack_hash = diefill::sha256_file(c.pack);
+      const std::size_t per_column = lowest_in_square(source, pack_column).size();
       for (std::size_t count : c.sizes) {
-        auto [model, tiled] = tiled_pack(source, count);
-        const std::string key = diefill::sha256_hex(pack_hash + model.hash).substr(0, 16);
-        const dem::State bed = settled_bed(model, std::move(tiled), c.cache / fmt::format("scaling_bed_{}_{}.ckpt", count, key), ranks);
-        results["cases"].push_back(time_case(fmt::format("scaling-{}", count), model, bed, c.steps, thread_counts, ranks));
+        Bed bed;
+        if (count <= per_column) {
+          bed = column_tile(source, count, true);
+          bed.grains = settled_bed(bed, c.cache, fmt::format("tile_{}", count), ranks);
+        } else {
+          // Equal tiles filling a rectangle: a gap in it would be a slope for the bed to flow down.
+          const std::size_t fewest = (count + per_column - 1) / per_column, across = std::size_t(std::ceil(std::sqrt(double(fewest))));
+          const std::size_t along = (fewest + across - 1) / across, tiles = across * along;
+          if (count % tiles != 0)
+            throw diefill::InputError("bench scaling", "--sizes", fmt::format("{} grains make {} equal tiles only as a multiple of {}", count, tiles, tiles),
+                                      fmt::format("Ask for {} or {} grains", count - count % tiles, count - count % tiles + tiles));
+          Bed tile = column_tile(source, count / tiles, false);
+          tile.grains = settled_bed(tile, c.cache, fmt::format("tile_{}", count / tiles), ranks);
+          bed = tiled_bed(tile.grains, pack_column, int(across), int(along));
+          bed.grains = settled_bed(bed, c.cache, fmt::format("bed_{}", count), ranks);
+        }
+        results["cases"].push_back(time_case(fmt::format("scaling-{}", count), bed.model, bed.grains, c.steps, thread_counts, ranks));
       }
     } else if (name == "run-ring") {
       scene::PipelineScene scene = scene::load_pipeline_scene(std::nullopt, {});
