@@ -19,7 +19,7 @@ echo "repeat,grains,threads,particle_steps_per_s,bytes_per_particle,peak_residen
 for k in $(seq 1 "$repeats"); do
   for n in "${sizes[@]}"; do
     "$root/build/diefill" bench scaling --pack "runs/$tag.packed.dump" --sizes "$n" \
-      --threads 1 --threads 2 --steps "$steps" --json "$work/scaling_${k}_$n.json" 2>/dev/null
+      --threads 1 --threads 2 --steps "$steps" --cache "$root/out/bench" --json "$work/scaling_${k}_$n.json" 2>/dev/null
     python3 - "$work/scaling_${k}_$n.json" "$k" >> "$csv" <<'PY'
 import json, sys
 for case in json.load(open(sys.argv[1]))["cases"]:
