@@ -232,8 +232,8 @@ std::pair<dem::Model, dem::State> ring_pack(std::size_t count, const fs::path& c
 // apart and falls back for tens of milliseconds, and timed so, its contacts fall (4.4 to 0.45-2.75
 // per grain in 2,000 steps) and fewer contacts make a faster step: the sizes would not be like for
 // like (docs/PERFORMANCE.md, "Against the grain count"). So a tile is settled alone, the bed is
-// laid out of mirrored copies of the settled tile with its contact histories, and settled again where the
-// copies meet (settled_bed).
+// laid out of mirrored copies of the settled tile with its contact histories, and settled again
+// where the copies meet (settled_bed).
 constexpr double pack_column = 30e-3;  // the largest square the 44 mm cylinder holds, nearly
 
 struct Bed {
@@ -265,10 +265,9 @@ std::vector<std::size_t> lowest_in_square(const dem::State& source, double side)
   return in_square;
 }
 
-// One tile of `count` grains: the lowest of the pack's column, or with `narrow`, the narrower
-// square of the column's height that holds them; standing on the floor.
-Bed column_tile(const dem::State& source, std::size_t count, bool narrow) {
-  const std::size_t per_column = lowest_in_square(source, pack_column).size();
+// One tile of `count` grains: the lowest of the pack's column (which holds `per_column`), or with
+// `narrow`, the narrower square of the column's height that holds them; standing on the floor.
+Bed column_tile(const dem::State& source, std::size_t count, std::size_t per_column, bool narrow) {
   // The square holding `count` by area holds fewer wholly inside: widened until it holds them.
   double side = narrow ? pack_column * std::sqrt(double(count) / double(per_column)) : pack_column;
   while (side < pack_column && lowest_in_square(source, side).size() < count) side = std::min(pack_column, 1.01 * side);
@@ -393,7 +392,7 @@ json run_cases(const Request& c, const std::shared_ptr<dem::Exchange>& ranks) {
       for (std::size_t count : c.sizes) {
         Bed bed;
         if (count <= per_column) {
-          bed = column_tile(source, count, true);
+          bed = column_tile(source, count, per_column, true);
           bed.grains = settled_bed(bed, c.cache, fmt::format("tile_{}", count), ranks);
         } else {
           // Equal tiles filling a rectangle: a gap in it would be a slope for the bed to flow down.
@@ -402,7 +401,7 @@ json run_cases(const Request& c, const std::shared_ptr<dem::Exchange>& ranks) {
           if (count % tiles != 0)
             throw diefill::InputError("bench scaling", "--sizes", fmt::format("{} grains make {} equal tiles only as a multiple of {}", count, tiles, tiles),
                                       fmt::format("Ask for {} or {} grains", count - count % tiles, count - count % tiles + tiles));
-          Bed tile = column_tile(source, count / tiles, false);
+          Bed tile = column_tile(source, count / tiles, per_column, false);
           tile.grains = settled_bed(tile, c.cache, fmt::format("tile_{}", count / tiles), ranks);
           bed = tiled_bed(tile.grains, pack_column, int(across), int(along));
           bed.grains = settled_bed(bed, c.cache, fmt::format("bed_{}", count), ranks);
