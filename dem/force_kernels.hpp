@@ -26,9 +26,10 @@ namespace kernel {
 
 // Contacts gathered from consecutive rows, as columns (one array per quantity), so that the
 // law runs over them as a loop the compiler vectorises. The columns start on cache lines, so
-// that the vector loads never straddle two, wherever the batch happens to lie.
+// that the vector loads never straddle two, wherever the batch happens to lie; the whole batch
+// (about 23 KB) fits a 32 KB first-level cache.
 struct alignas(64) ContactBatch {
-  static constexpr int capacity = 192;  // a multiple of 8: every column a whole number of lines
+  static constexpr int capacity = 64;  // a multiple of 8: every column a whole number of lines
   int size = 0;
   alignas(64) std::int32_t pair[capacity], row[capacity], partner[capacity], slot[capacity];
   // in: separation x_i - x_j, radii, masses, velocities, history, pair parameters
