@@ -77,21 +77,23 @@ void rename_members(CellGrid& g, const std::vector<std::int32_t>& new_index) {
   for (std::size_t m = 0; m < g.members.size(); ++m) g.members[m] = new_index[std::size_t(g.members[m])];
 }
 
-// Applies `order` (new index -> old index) to every per-particle array, through a scratch array
-// per element type kept from one rebuild to the next: fresh arrays cost their page faults and
-// zeroing at every rebuild (on 500k grains the rebuilds' share of the step rose from 22 to 30 %).
-template <typename Values>
-void permute(Values& a, const std::vector<std::int32_t>& order) {
-  static thread_local Values scratch;
-  // Exactly the size (a resize past the capacity could double it, and the arrays take turns
-  // with the scratch).
-  if (scratch.capacity() < order.size()) scratch.clear(), scratch.reserve(order.size());
+// Applies `order` (new index -> old index) to per-particle arrays of one element type: each is
+// gathered into a scratch array and swapped with it, so that the arrays take turns with one
+// scratch, freed when they are done: kept from one rebuild to the next (one per element type) it
+// was 45 bytes per grain held between rebuilds, outside the state (issue 47's honest bytes per
+// grain; docs/PERFORMANCE.md, "Memory").
+template <typename Values, typename... More>
+void permute(const std::vector<std::int32_t>& order, Values& first, More&... more) {
+  Values scratch;
+  scratch.reserve(order.size());  // exactly the size: the arrays take turns with it
   scratch.resize(order.size());
-  auto* const out = scratch.data();
-  const auto* const in = a.data();
+  for (Values* a : {&first, &more...}) {
+    auto* const out = scratch.data();
+    const auto* const in = a->data();
 #pragma omp parallel for schedule(static)
-  for (std::size_t n = 0; n < order.size(); ++n) out[n] = in[std::size_t(order[n])];
-  a.swap(scratch);
+    for (std::size_t n = 0; n < order.size(); ++n) out[n] = in[std::size_t(order[n])];
+    a->swap(scratch);
+  }
 }
 
 // Interleaves the bits of a cell's coordinates (Morton order): consecutive particles then fill
@@ -127,24 +129,18 @@ std::vector<std::int32_t> sort_particles(State& s, const CellGrid& g, std::vecto
   std::vector<std::int32_t> order;
   order.reserve(s.size());
   for (const auto& [key, i] : keyed) order.push_back(i);
+  std::vector<std::pair<std::uint64_t, std::int32_t>>().swap(keyed);  // 16 bytes a grain, done with
   for (std::size_t i = 0; i < s.owned(); ++i)
     if (!s.active[i]) order.push_back(std::int32_t(i));
   for (std::size_t i = s.owned(); i < s.size(); ++i) order.push_back(std::int32_t(i));
   new_index.assign(s.size(), -1);
 #pragma omp parallel for schedule(static)
   for (std::size_t n = 0; n < order.size(); ++n) new_index[std::size_t(order[n])] = std::int32_t(n);
-  permute(s.id, order);
-  permute(s.x, order);
-  permute(s.v, order);
-  permute(s.w, order);
-  permute(s.f, order);
-  permute(s.torque, order);
-  permute(s.radius, order);
-  permute(s.mass, order);
-  permute(s.inertia, order);
-  permute(s.material, order);
-  permute(s.active, order);
-  permute(s.body, order);
+  permute(order, s.x, s.v, s.w, s.f, s.torque);
+  permute(order, s.radius, s.mass, s.inertia);
+  permute(order, s.id);
+  permute(order, s.material, s.body);
+  permute(order, s.active);
   for (std::int32_t& i : s.bodies.member) i = new_index[std::size_t(i)];
   return order;
 }
@@ -258,6 +254,140 @@ void visit_carried_histories(const State& s, const IdIndex& index, Add add) {
       add(OldPair{std::int32_t(i), std::int32_t(j), c.tangential, c.rolling});
 }
 
+// The old pairs' histories by the new indices, grouped by row in a counting sort (linear,
+// stable: within a row the old list's order, the same every run; split over ranks, a pair that met
+// across a subdomain face comes once from each side, the two views agreeing to rounding, and the
+// first is taken). They come from the list or, split over ranks, with the grains, by global id
+// (exchange.hpp); those carried ones are then done with.
+RowHistories take_old_histories(State& s, const std::vector<std::int32_t>& new_index, bool tangential, bool rolling) {
+  const NeighbourList& nl = s.neighbours;
+  const std::size_t n = s.size();
+  RowHistories old;
+  if (s.exchange) {
+    const IdIndex index(s, n);
+    histories_by_row(n, tangential, rolling, [&](auto add) {
+      if (!s.renumbered.empty()) visit_listed_histories(nl, s.renumbered, new_index, add);
+      visit_carried_histories(s, index, add);
+    }, old);
+    std::vector<CarriedPair>().swap(s.carried_pairs);
+    std::vector<std::int32_t>().swap(s.renumbered);
+  } else {
+    histories_by_row(n, tangential, rolling, [&](auto add) { visit_listed_histories(nl, {}, new_index, add); }, old);
+  }
+  return old;
+}
+
+// The new list's partners as the row scan finds them: each thread's rows in a buffer of its own
+// (one vector per row cost half a million allocations per rebuild on 500k grains), in the chunks
+// of consecutive rows the scan's dynamic schedule hands out, each chunk's thread and start in that
+// buffer kept (not each row's: 8 bytes a grain less at the rebuild's peak), and every row's length.
+struct FoundRows {
+  static constexpr std::size_t chunk = 256;  // rows
+  std::vector<std::vector<std::int32_t>> by_thread;
+  std::vector<std::int32_t> chunk_thread, chunk_begin;  // [chunks]
+  std::vector<std::int32_t> length;                     // [N]
+};
+
+// Rows in parallel: every owned particle scans the 27 cells around it for j > i within reach
+// (ghosts, after the owned ones, are partners only). The grid is taken, and freed on return,
+// before the list's arrays fill at the rebuild's peak.
+FoundRows scan_rows(const Model& model, const State& s, const CellGrid grid, std::size_t listed_before) {
+  FoundRows rows;
+  rows.by_thread.resize(static_cast<std::size_t>(omp_get_max_threads()));
+  const std::size_t chunks = (s.owned() + FoundRows::chunk - 1) / FoundRows::chunk;
+  rows.chunk_thread.assign(chunks, 0);
+  rows.chunk_begin.assign(chunks, 0);
+  rows.length.assign(s.size(), 0);
+#pragma omp parallel
+  {
+    const int thread = omp_get_thread_num();
+    std::vector<std::int32_t>& buffer = rows.by_thread[std::size_t(thread)];
+    buffer.reserve(listed_before / rows.by_thread.size() + 1024);
+    std::vector<std::int32_t> apart;
+    // A dynamic schedule hands out chunks of consecutive iterations, the k-th starting at k * chunk.
+#pragma omp for schedule(dynamic, FoundRows::chunk)
+  for (std::size_t i = 0; i < s.owned(); ++i) {
+    if (i % FoundRows::chunk == 0)
+      rows.chunk_thread[i / FoundRows::chunk] = thread, rows.chunk_begin[i / FoundRows::chunk] = std::int32_t(buffer.size());
+    if (!s.active[i]) continue;
+    const Vec3& xi = s.x[i];
+    const std::int32_t body = s.body[i];
+    const int cx = grid.cell_coord(xi.x(), 0), cy = grid.cell_coord(xi.y(), 1), cz = grid.cell_coord(xi.z(), 2);
+    const std::size_t begin = buffer.size();
+    for (int a = std::max(0, cx - 1); a <= std::min(grid.dims[0] - 1, cx + 1); ++a)
+      for (int b = std::max(0, cy - 1); b <= std::min(grid.dims[1] - 1, cy + 1); ++b)
+        for (int c = std::max(0, cz - 1); c <= std::min(grid.dims[2] - 1, cz + 1); ++c) {
+          const std::size_t cell = (std::size_t(a) * std::size_t(grid.dims[1]) + std::size_t(b)) * std::size_t(grid.dims[2]) + std::size_t(c);
+          for (std::int32_t m = grid.start[cell]; m < grid.start[cell + 1]; ++m) {
+            const std::int32_t j = grid.members[std::size_t(m)];
+            // Members of one clump never touch: the clump is rigid.
+            if (j <= std::int32_t(i) || (body >= 0 && s.body[std::size_t(j)] == body)) continue;
+            const double reach = s.radius[i] + s.radius[std::size_t(j)] + model.skin;
+            if ((s.x[std::size_t(j)] - xi).squaredNorm() < reach * reach) buffer.push_back(j);
+          }
+        }
+    // Pairs touching now first, then the others, each part ascending: the force loop tests every
+    // listed pair for contact, and contacts last thousands of steps, so the outcome runs in two
+    // predictable stretches per row instead of at random (a mispredicted branch per pair cost
+    // about a tenth of the force loop).
+    // (In place, with the apart ones kept aside in the thread's own list: std::stable_partition
+    // allocated a buffer per row.)
+    const auto row = buffer.begin() + std::ptrdiff_t(begin);
+    std::sort(row, buffer.end());
+    auto kept = row;
+    apart.clear();
+    for (auto it = row; it != buffer.end(); ++it) {
+      const double reach = s.radius[i] + s.radius[std::size_t(*it)];
+      if ((s.x[std::size_t(*it)] - xi).squaredNorm() < reach * reach) *kept++ = *it;
+      else apart.push_back(*it);
+    }
+    std::copy(apart.begin(), apart.end(), kept);
+    rows.length[i] = std::int32_t(buffer.size() - begin);
+  }
+  }
+  return rows;
+}
+
+// Sizes a list array for the new build, in place when it has the room; otherwise it is freed before
+// the new one is allocated (assign would hold both at once, at the rebuild's peak): its values were
+// taken into the old histories already.
+template <typename Values>
+void refill(Values& a, std::size_t count, const typename Values::value_type& value) {
+  if (count > a.capacity()) Values().swap(a);
+  a.assign(count, value);
+}
+
+// The new list from the scan's rows, each pair with the history its two grains had, or none.
+void fill_list(NeighbourList& nl, const FoundRows& rows, const RowHistories& old, bool tangential, bool rolling) {
+  const std::size_t n = rows.length.size();
+  nl.row_start.assign(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) nl.row_start[i + 1] = nl.row_start[i] + rows.length[i];
+  const std::size_t pairs = std::size_t(nl.row_start[n]);
+  refill(nl.partner, pairs, 0);
+  refill(nl.tangential, tangential ? pairs : 0, Vec3::Zero());
+  refill(nl.rolling, rolling ? pairs : 0, Vec3::Zero());
+  refill(nl.touching, pairs, std::uint8_t(0));
+#pragma omp parallel for schedule(static)
+  for (std::size_t chunk = 0; chunk < rows.chunk_thread.size(); ++chunk) {
+    const std::int32_t* row = rows.by_thread[std::size_t(rows.chunk_thread[chunk])].data() + rows.chunk_begin[chunk];
+    for (std::size_t i = chunk * FoundRows::chunk; i < std::min(n, (chunk + 1) * FoundRows::chunk); row += rows.length[i++]) {
+      const auto history_begin = old.partner.begin() + old.start[i], history_end = old.partner.begin() + old.start[i + 1];
+      for (std::int32_t k = 0, p = nl.row_start[i]; k < rows.length[i]; ++k, ++p) {
+        const std::int32_t j = row[k];
+        nl.partner[std::size_t(p)] = j;
+        // A grain has a dozen listed partners, a few with history: a scan beats a search.
+        const auto history = std::find(history_begin, history_end, j);
+        if (history != history_end) {
+          const auto h = std::size_t(history - old.partner.begin());
+          if (tangential) nl.tangential[std::size_t(p)] = old.tangential[h];
+          if (rolling) nl.rolling[std::size_t(p)] = old.rolling[h];
+          nl.touching[std::size_t(p)] = 1;
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 
 bool needs_rebuild(const Model& model, const State& s, double largest_shift2) {
@@ -298,111 +428,24 @@ void lose_outside_domain(const Model& model, State& s) {
 void rebuild_neighbours(const Model& model, State& s) {
   lose_outside_domain(model, s);
 
-  // The old pairs' histories come from the list (or, split over ranks, with the grains, by global
-  // id: exchange.hpp), matched to the new list's pairs below.
   NeighbourList& nl = s.neighbours;
   const bool tangential = model.contact_law->keeps_tangential, rolling = model.contact_law->keeps_rolling;
   const Array<std::int32_t> old_near = nl.near_wall;
   const Array<WallSlot> old_slots = std::move(s.wall_slots);
-
-  CellGrid grid = make_grid(model, s);
-  std::vector<std::int32_t> new_index;
-  const std::vector<std::int32_t> order = sort_particles(s, grid, new_index);
-  if (s.exchange) s.exchange->reordered(new_index);
-  rename_members(grid, new_index);
-  // By row, in a counting sort (linear, stable: within a row the old list's order, the same every
-  // run; split over ranks, a pair that met across a subdomain face comes once from each side, the
-  // two views agreeing to rounding, and the first is taken).
-  const std::size_t n = s.size();
-  RowHistories old;
-  if (s.exchange) {
-    const IdIndex index(s, n);
-    histories_by_row(n, tangential, rolling, [&](auto add) {
-      if (!s.renumbered.empty()) visit_listed_histories(nl, s.renumbered, new_index, add);
-      visit_carried_histories(s, index, add);
-    }, old);
-    std::vector<CarriedPair>().swap(s.carried_pairs);
-    std::vector<std::int32_t>().swap(s.renumbered);
-  } else {
-    histories_by_row(n, tangential, rolling, [&](auto add) { visit_listed_histories(nl, {}, new_index, add); }, old);
-  }
-
-  // Rows in parallel: every owned particle scans the 27 cells around it for j > i within reach
-  // (ghosts, after the owned ones, are partners only), into its thread's buffer (one vector per
-  // row cost half a million allocations per rebuild on 500k grains).
-  std::vector<std::vector<std::int32_t>> found(static_cast<std::size_t>(omp_get_max_threads()));
-  std::vector<std::int32_t> row_thread(n, 0), row_begin(n, 0), row_length(n, 0);
-#pragma omp parallel
+  std::vector<std::int32_t> new_index, order;
   {
-    std::vector<std::int32_t>& buffer = found[std::size_t(omp_get_thread_num())];
-    buffer.reserve(nl.partner.size() / found.size() + 1024);
-    std::vector<std::int32_t> apart;
-#pragma omp for schedule(dynamic, 256)
-  for (std::size_t i = 0; i < s.owned(); ++i) {
-    if (!s.active[i]) continue;
-    const Vec3& xi = s.x[i];
-    const std::int32_t body = s.body[i];
-    const int cx = grid.cell_coord(xi.x(), 0), cy = grid.cell_coord(xi.y(), 1), cz = grid.cell_coord(xi.z(), 2);
-    const std::size_t begin = buffer.size();
-    for (int a = std::max(0, cx - 1); a <= std::min(grid.dims[0] - 1, cx + 1); ++a)
-      for (int b = std::max(0, cy - 1); b <= std::min(grid.dims[1] - 1, cy + 1); ++b)
-        for (int c = std::max(0, cz - 1); c <= std::min(grid.dims[2] - 1, cz + 1); ++c) {
-          const std::size_t cell = (std::size_t(a) * std::size_t(grid.dims[1]) + std::size_t(b)) * std::size_t(grid.dims[2]) + std::size_t(c);
-          for (std::int32_t m = grid.start[cell]; m < grid.start[cell + 1]; ++m) {
-            const std::int32_t j = grid.members[std::size_t(m)];
-            // Members of one clump never touch: the clump is rigid.
-            if (j <= std::int32_t(i) || (body >= 0 && s.body[std::size_t(j)] == body)) continue;
-            const double reach = s.radius[i] + s.radius[std::size_t(j)] + model.skin;
-            if ((s.x[std::size_t(j)] - xi).squaredNorm() < reach * reach) buffer.push_back(j);
-          }
-        }
-    // Pairs touching now first, then the others, each part ascending: the force loop tests every
-    // listed pair for contact, and contacts last thousands of steps, so the outcome runs in two
-    // predictable stretches per row instead of at random (a mispredicted branch per pair cost
-    // about a tenth of the force loop).
-    // (In place, with the apart ones kept aside in the thread's own list: std::stable_partition
-    // allocated a buffer per row.)
-    const auto row = buffer.begin() + std::ptrdiff_t(begin);
-    std::sort(row, buffer.end());
-    auto kept = row;
-    apart.clear();
-    for (auto it = row; it != buffer.end(); ++it) {
-      const double reach = s.radius[i] + s.radius[std::size_t(*it)];
-      if ((s.x[std::size_t(*it)] - xi).squaredNorm() < reach * reach) *kept++ = *it;
-      else apart.push_back(*it);
-    }
-    std::copy(apart.begin(), apart.end(), kept);
-    row_thread[i] = omp_get_thread_num(), row_begin[i] = std::int32_t(begin), row_length[i] = std::int32_t(buffer.size() - begin);
-  }
-  }
-
-  nl.row_start.assign(n + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) nl.row_start[i + 1] = nl.row_start[i] + row_length[i];
-  const std::size_t pairs = std::size_t(nl.row_start[n]);
-  nl.partner.resize(pairs);
-  nl.tangential.assign(tangential ? pairs : 0, Vec3::Zero());
-  nl.rolling.assign(rolling ? pairs : 0, Vec3::Zero());
-  nl.touching.assign(pairs, 0);
-#pragma omp parallel for schedule(static)
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto history_begin = old.partner.begin() + old.start[i], history_end = old.partner.begin() + old.start[i + 1];
-    const std::int32_t* row = found[std::size_t(row_thread[i])].data() + row_begin[i];
-    for (std::int32_t k = 0, p = nl.row_start[i]; k < row_length[i]; ++k, ++p) {
-      const std::int32_t j = row[k];
-      nl.partner[std::size_t(p)] = j;
-      // A grain has a dozen listed partners, a few with history: a scan beats a search.
-      const auto history = std::find(history_begin, history_end, j);
-      if (history != history_end) {
-        const auto h = std::size_t(history - old.partner.begin());
-        if (tangential) nl.tangential[std::size_t(p)] = old.tangential[h];
-        if (rolling) nl.rolling[std::size_t(p)] = old.rolling[h];
-        nl.touching[std::size_t(p)] = 1;
-      }
-    }
-  }
+    CellGrid grid = make_grid(model, s);
+    order = sort_particles(s, grid, new_index);
+    if (s.exchange) s.exchange->reordered(new_index);
+    rename_members(grid, new_index);
+    const RowHistories old = take_old_histories(s, new_index, tangential, rolling);
+    const FoundRows rows = scan_rows(model, s, std::move(grid), nl.partner.size());
+    fill_list(nl, rows, old, tangential, rolling);
+  }  // the scratch is freed before the cross pairs are indexed
+  const std::size_t n = s.size();
   index_cross_pairs(nl, n, s.owned());
-  s.cross_forces.force.assign(nl.cross_reverse.size(), Vec3::Zero());
-  s.cross_forces.torque.assign(nl.cross_reverse.size(), Vec3::Zero());
+  refill(s.cross_forces.force, nl.cross_reverse.size(), Vec3::Zero());
+  refill(s.cross_forces.torque, nl.cross_reverse.size(), Vec3::Zero());
 
   nl.x_at_build = s.x;
   nl.time_at_build = s.time;
