@@ -404,9 +404,10 @@ json run_cases(const Request& c, const std::shared_ptr<dem::Exchange>& ranks) {
           Bed tile = column_tile(source, count / tiles, per_column, false);
           tile.grains = settled_bed(tile, c.cache, fmt::format("tile_{}", count / tiles), ranks);
           bed = tiled_bed(tile.grains, pack_column, int(across), int(along));
-          bed.grains = settled_bed(bed, c.cache, fmt::format("bed_{}", count), ranks);
+          if (!c.unsettled_beds) bed.grains = settled_bed(bed, c.cache, fmt::format("bed_{}", count), ranks);
         }
         results["cases"].push_back(time_case(fmt::format("scaling-{}", count), bed.model, bed.grains, c.steps, thread_counts, ranks));
+        results["cases"].back()["bed_settled"] = count <= per_column || !c.unsettled_beds;
       }
     } else if (name == "run-ring") {
       scene::PipelineScene scene = scene::load_pipeline_scene(std::nullopt, {});

@@ -27,6 +27,10 @@ struct Request {
   std::filesystem::path pack;      // liggghts, scaling: the settled pack (LAMMPS dump)
   std::filesystem::path stl;       // liggghts: the container (mm)
   std::vector<std::size_t> sizes = {5000, 15000, 50000, 150000, 500000};  // scaling: grain counts
+  // scaling: a bed of several tiles as laid out, not settled again (its seams move while it is
+  // timed, so its rate is not like for like): for its bytes per grain and its rebuild's time
+  // without the settling (over an hour for 500k grains).
+  bool unsettled_beds = false;
   std::int64_t grains = 10'000'000;  // mpi-bed: the bed's grains
   std::int64_t checkpoint_at = 0;    // mpi-bed: the step at which a checkpoint is written (0: none)
   std::filesystem::path resume;      // mpi-bed: go on from this checkpoint

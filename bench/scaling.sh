@@ -8,12 +8,15 @@
 # arrays' bytes per grain, the peak resident bytes per grain with the rebuild's scratch and the
 # allocator's rounding, one rebuild's time over a step's), the medians to
 # bench/results/scaling.json and the chart to docs/scaling.png.
-#   bench/scaling.sh [REPEATS=3] [STEPS=2000]
+# SIZES (grain counts, default all five) times fewer: a bed not yet settled takes its settling
+# first (all five took about 50 minutes of both cores on an Intel Xeon kind; the 500k bed alone
+# is over an hour on an AMD EPYC Zen 1).
+#   bench/scaling.sh [REPEATS=3] [STEPS=2000] [SIZES="5000 15000 50000 150000 500000"]
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 repeats="${1:-3}"; steps="${2:-2000}"; size=50k
+read -r -a sizes <<< "${3:-5000 15000 50000 150000 500000}"
 source "$root/bench/liggghts_pack.sh"
-sizes=(5000 15000 50000 150000 500000)
 csv="$root/bench/results/scaling.csv"
 echo "repeat,grains,threads,particle_steps_per_s,bytes_per_particle,peak_resident_bytes_per_particle,rebuild_over_step,neighbour_builds,contacts_per_grain_at_start,contacts_per_grain" > "$csv"
 for k in $(seq 1 "$repeats"); do
@@ -54,7 +57,12 @@ for t in (1, 2):
                       "contacts_per_grain_at_end_median": statistics.median(float(r["contacts_per_grain"]) for r in at),
                       **({"bytes_per_particle": float(at[0]["bytes_per_particle"])} if at[0]["bytes_per_particle"] else {})})
     first = cases[0]["median"]
-    out[f"threads_{t}"] = {"sizes": cases, "largest_fall_from_smallest": max(0.0, 1 - min(c["median"] for c in cases) / first)}
+    # Each size's rate over the smallest size's, within each round (the host moves between rounds).
+    rate = {(r["repeat"], int(r["grains"])): float(r["particle_steps_per_s"]) for r in mine}
+    rounds = sorted({k for k, _ in rate}, key=int)
+    per_round = {str(n): [rate[k, n] / rate[k, sizes[0]] for k in rounds if (k, n) in rate and (k, sizes[0]) in rate] for n in sizes[1:]}
+    out[f"threads_{t}"] = {"sizes": cases, "largest_fall_from_smallest": max(0.0, 1 - min(c["median"] for c in cases) / first),
+                           "per_round_over_smallest": {n: {"rounds": r, "median": statistics.median(r), "min": min(r)} for n, r in per_round.items()}}
 json.dump(out, open(sys.argv[2], "w"), indent=2)
 fig, ax = plt.subplots(figsize=(6, 4))
 for t in (1, 2):

@@ -123,6 +123,8 @@ void add_bench(CLI::App& root, cli::BenchCommand& c, std::function<int()>& actio
   cmd->add_option("--pack", c.request.pack, "liggghts: settled pack (LAMMPS dump: id x y z radius vx vy vz)");
   cmd->add_option("--stl", c.request.stl, "liggghts: container mesh (mm)");
   cmd->add_option("--sizes", c.request.sizes, "scaling: grain counts")->capture_default_str();
+  cmd->add_flag("--unsettled-beds", c.request.unsettled_beds,
+                "scaling: time beds of several tiles as laid out, not settled again (for bytes per grain and the rebuild's time; their rates are not like for like)");
   cmd->add_option("--grains", c.request.grains, "mpi-bed: grains in the bed")->capture_default_str();
   cmd->add_option("--checkpoint-at", c.request.checkpoint_at, "mpi-bed: write a checkpoint (CACHE/mpi-bed/checkpoint.bin) at this step");
   cmd->add_option("--resume", c.request.resume, "mpi-bed: go on from this checkpoint to --steps");
