@@ -8,9 +8,9 @@
 # arrays' bytes per grain, the peak resident bytes per grain with the rebuild's scratch and the
 # allocator's rounding, one rebuild's time over a step's), the medians to
 # bench/results/scaling.json and the chart to docs/scaling.png.
-# SIZES (grain counts, default all five) times fewer: a bed not yet settled takes its settling
-# first (all five took about 50 minutes of both cores on an Intel Xeon kind; the 500k bed alone
-# is over an hour on an AMD EPYC Zen 1).
+# SIZES: the grain counts to time (default all five). A bed not yet settled is settled first: all
+# five took about 50 minutes of both cores on an Intel Xeon kind, the 500k bed alone is over an
+# hour on an AMD EPYC Zen 1.
 #   bench/scaling.sh [REPEATS=3] [STEPS=2000] [SIZES="5000 15000 50000 150000 500000"]
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
