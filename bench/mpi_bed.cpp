@@ -59,7 +59,7 @@ dem::State share_of_bed(const Bed& bed, int rank, int ranks) {
   dem::State s;
   const std::size_t n = std::size_t(last - first);
   for (auto* a : {&s.x, &s.v, &s.w, &s.f, &s.torque}) a->reserve(n);
-  for (auto* a : {&s.radius, &s.mass, &s.inertia}) a->reserve(n);
+  for (auto* a : {&s.radius, &s.mass}) a->reserve(n);
   s.id.reserve(n), s.material.reserve(n), s.active.reserve(n), s.body.reserve(n);
   for (std::int64_t k = first; k < last; ++k) {
     const std::int64_t l = k % layers, j = k / layers % bed.wide, i = k / layers / bed.wide;

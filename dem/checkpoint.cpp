@@ -17,9 +17,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr char magic[8] = {'D', 'F', 'C', 'K', 'P', 'T', '0', '7'};
+constexpr char magic[8] = {'D', 'F', 'C', 'K', 'P', 'T', '0', '8'};
 constexpr char split_magic[8] = {'D', 'F', 'C', 'K', 'S', 'P', '0', '4'};
-constexpr char piece_magic[8] = {'D', 'F', 'C', 'K', 'P', 'C', '0', '4'};
+constexpr char piece_magic[8] = {'D', 'F', 'C', 'K', 'P', 'C', '0', '5'};
 
 // Streams straight into the file: a rank's piece of ten million grains is never held twice.
 struct Writer {
@@ -61,7 +61,6 @@ void fields(IO& io, S& s) {
   io.array(s.torque);
   io.array(s.radius);
   io.array(s.mass);
-  io.array(s.inertia);
   io.array(s.material);
   io.array(s.active);
   io.array(s.body);

@@ -13,14 +13,14 @@ GrainRecord grain_record(const State& s, std::size_t i) {
   GrainRecord g;
   std::memset(static_cast<void*>(&g), 0, sizeof g);  // padding too: the same state gives the same bytes
   g.id = s.id[i], g.x = s.x[i], g.v = s.v[i], g.w = s.w[i];
-  g.radius = s.radius[i], g.mass = s.mass[i], g.inertia = s.inertia[i], g.material = s.material[i], g.active = s.active[i];
+  g.radius = s.radius[i], g.mass = s.mass[i], g.material = s.material[i], g.active = s.active[i];
   return g;
 }
 
 void append_grain(State& s, const GrainRecord& g) {
   s.id.push_back(g.id), s.x.push_back(g.x), s.v.push_back(g.v), s.w.push_back(g.w);
   s.f.push_back(Vec3::Zero()), s.torque.push_back(Vec3::Zero());
-  s.radius.push_back(g.radius), s.mass.push_back(g.mass), s.inertia.push_back(g.inertia);
+  s.radius.push_back(g.radius), s.mass.push_back(g.mass);
   s.material.push_back(g.material), s.active.push_back(g.active), s.body.push_back(-1);
 }
 
@@ -36,7 +36,7 @@ std::int64_t IdIndex::find(std::int64_t id) const {
 
 void reserve_grains(State& s, std::size_t grains) {
   const auto room = [grains](auto&... arrays) { (arrays.reserve(grains), ...); };
-  room(s.id, s.x, s.v, s.w, s.f, s.torque, s.radius, s.mass, s.inertia, s.material, s.active, s.body);
+  room(s.id, s.x, s.v, s.w, s.f, s.torque, s.radius, s.mass, s.material, s.active, s.body);
 }
 
 BodyRecord body_record(const Bodies& B, std::size_t b) {
@@ -76,7 +76,7 @@ void keep_grains(State& s, const std::vector<std::size_t>& keep) {
   };
   const std::size_t before = s.size();
   select(s.id), select(s.x), select(s.v), select(s.w), select(s.f), select(s.torque);
-  select(s.radius), select(s.mass), select(s.inertia), select(s.material), select(s.active), select(s.body);
+  select(s.radius), select(s.mass), select(s.material), select(s.active), select(s.body);
   if (s.bodies.size() == 0) return;
   std::vector<std::int32_t> new_index(before, -1);
   for (std::size_t k = 0; k < keep.size(); ++k) new_index[keep[k]] = std::int32_t(k);

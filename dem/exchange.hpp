@@ -22,14 +22,14 @@ struct State;
 // rank when it migrates.
 struct CarriedPair {
   std::int64_t id, partner;
-  Vec3 tangential, rolling;
+  Vec3f tangential, rolling;
 };
 
 // A grain as it travels between ranks (a ghost's copy, or a grain gathered for the outputs).
 struct GrainRecord {
   std::int64_t id;
   Vec3 x, v, w;
-  double radius, mass, inertia;
+  double radius, mass;
   std::int32_t material;
   std::uint8_t active;
   std::uint8_t unused[3];  // the padding, named: copies (a sort's too) keep it zero, and a file the same

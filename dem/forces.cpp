@@ -101,7 +101,7 @@ void sum_forces(State& s, double kick_dt) {
     // Clump members move with their bodies, kicked once their members' forces are summed.
     if (kick_dt > 0 && s.body[j] < 0) {
       s.v[j] += (kick_dt / s.mass[j]) * f;
-      s.w[j] += (kick_dt / s.inertia[j]) * t;
+      s.w[j] += (kick_dt / sphere_inertia(s.mass[j], s.radius[j])) * t;
     }
   }
 }

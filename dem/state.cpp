@@ -15,7 +15,6 @@ void State::add_sphere(std::int64_t particle_id, const Vec3& position, double r,
   torque.push_back(Vec3::Zero());
   radius.push_back(r);
   mass.push_back(m);
-  inertia.push_back(0.4 * m * r * r);
   material.push_back(material_index);
   active.push_back(1);
   body.push_back(-1);
@@ -24,7 +23,7 @@ void State::add_sphere(std::int64_t particle_id, const Vec3& position, double r,
 std::size_t State::memory_bytes() const {
   std::size_t total = 0;
   const auto add = [&total](const auto&... arrays) { ((total += arrays.capacity() * sizeof(arrays[0])), ...); };
-  add(id, x, v, w, f, torque, radius, mass, inertia, material, active, body, wall_slots, scratch_wall_power, wall_candidates);
+  add(id, x, v, w, f, torque, radius, mass, material, active, body, wall_slots, scratch_wall_power, wall_candidates);
   add(bodies.x, bodies.v, bodies.q, bodies.l, bodies.f, bodies.torque, bodies.mass, bodies.inertia, bodies.volume,
       bodies.active, bodies.member_start, bodies.member, bodies.offset);
   const NeighbourList& nl = neighbours;

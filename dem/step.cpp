@@ -38,7 +38,7 @@ double kick_and_drift(State& s, double half_dt, double dt) {
   kick_bodies(s, half_dt);
   drift_bodies(s, dt);
   const std::size_t n = s.owned();
-  const Array<Vec3>& built = s.neighbours.x_at_build;
+  const Array<Vec3f>& built = s.neighbours.x_at_build;
   const bool listed = built.size() == s.size();
   // No list (a state read back or shared anew): every rank rebuilds, one holding no grain too.
   double largest = listed ? 0 : std::numeric_limits<double>::infinity();
@@ -47,10 +47,10 @@ double kick_and_drift(State& s, double half_dt, double dt) {
     if (!s.active[i]) continue;
     if (s.body[i] < 0) {
       s.v[i] += (half_dt / s.mass[i]) * s.f[i];
-      s.w[i] += (half_dt / s.inertia[i]) * s.torque[i];
+      s.w[i] += (half_dt / sphere_inertia(s.mass[i], s.radius[i])) * s.torque[i];
       s.x[i] += dt * s.v[i];
     }
-    if (listed) largest = std::max(largest, (s.x[i] - built[i]).squaredNorm());
+    if (listed) largest = std::max(largest, (s.x[i] - built[i].cast<double>()).squaredNorm());
   }
   return largest;
 }
@@ -202,7 +202,7 @@ double global_sum(const State& s, double local) { return s.exchange ? s.exchange
 double kinetic_energy(const State& s) {
   double e = 0;
   for (std::size_t i = 0; i < s.owned(); ++i)
-    if (s.active[i] && s.body[i] < 0) e += 0.5 * s.mass[i] * s.v[i].squaredNorm() + 0.5 * s.inertia[i] * s.w[i].squaredNorm();
+    if (s.active[i] && s.body[i] < 0) e += 0.5 * s.mass[i] * s.v[i].squaredNorm() + 0.5 * sphere_inertia(s.mass[i], s.radius[i]) * s.w[i].squaredNorm();
   return e + body_kinetic_energy(s);
 }
 
