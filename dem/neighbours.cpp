@@ -277,73 +277,68 @@ RowHistories take_old_histories(State& s, const std::vector<std::int32_t>& new_i
   return old;
 }
 
-// The new list's partners as the row scan finds them: each thread's rows in a buffer of its own
-// (one vector per row cost half a million allocations per rebuild on 500k grains), in the chunks
-// of consecutive rows the scan's dynamic schedule hands out, each chunk's thread and start in that
-// buffer kept (not each row's: 8 bytes a grain less at the rebuild's peak), and every row's length.
+// The new list's partners as the row scan finds them, in the chunks of consecutive rows the scan's
+// dynamic schedule hands out, and every row's length. A chunk's rows, one after the other, take an
+// array of their exact size: a vector per row cost half a million allocations per rebuild on 500k
+// grains, and a growing buffer per thread kept up to half of itself spare, more on the thread the
+// schedule gave more rows (10 bytes a grain at the rebuild's peak at 500k grains, two threads).
 struct FoundRows {
   static constexpr std::size_t chunk = 256;  // rows
-  std::vector<std::vector<std::int32_t>> by_thread;
-  std::vector<std::int32_t> chunk_thread, chunk_begin;  // [chunks]
-  std::vector<std::int32_t> length;                     // [N]
+  std::vector<std::vector<std::int32_t>> by_chunk;  // [chunks]
+  std::vector<std::int32_t> length;  // [N]
 };
 
 // Rows in parallel: every owned particle scans the 27 cells around it for j > i within reach
 // (ghosts, after the owned ones, are partners only). The grid is taken, and freed on return,
 // before the list's arrays fill at the rebuild's peak.
-FoundRows scan_rows(const Model& model, const State& s, const CellGrid grid, std::size_t listed_before) {
+FoundRows scan_rows(const Model& model, const State& s, const CellGrid grid) {
   FoundRows rows;
-  rows.by_thread.resize(static_cast<std::size_t>(omp_get_max_threads()));
-  const std::size_t chunks = (s.owned() + FoundRows::chunk - 1) / FoundRows::chunk;
-  rows.chunk_thread.assign(chunks, 0);
-  rows.chunk_begin.assign(chunks, 0);
+  rows.by_chunk.resize((s.owned() + FoundRows::chunk - 1) / FoundRows::chunk);
   rows.length.assign(s.size(), 0);
 #pragma omp parallel
   {
-    const int thread = omp_get_thread_num();
-    std::vector<std::int32_t>& buffer = rows.by_thread[std::size_t(thread)];
-    buffer.reserve(listed_before / rows.by_thread.size() + 1024);
-    std::vector<std::int32_t> apart;
-    // A dynamic schedule hands out chunks of consecutive iterations, the k-th starting at k * chunk.
-#pragma omp for schedule(dynamic, FoundRows::chunk)
-  for (std::size_t i = 0; i < s.owned(); ++i) {
-    if (i % FoundRows::chunk == 0)
-      rows.chunk_thread[i / FoundRows::chunk] = thread, rows.chunk_begin[i / FoundRows::chunk] = std::int32_t(buffer.size());
-    if (!s.active[i]) continue;
-    const Vec3& xi = s.x[i];
-    const std::int32_t body = s.body[i];
-    const int cx = grid.cell_coord(xi.x(), 0), cy = grid.cell_coord(xi.y(), 1), cz = grid.cell_coord(xi.z(), 2);
-    const std::size_t begin = buffer.size();
-    for (int a = std::max(0, cx - 1); a <= std::min(grid.dims[0] - 1, cx + 1); ++a)
-      for (int b = std::max(0, cy - 1); b <= std::min(grid.dims[1] - 1, cy + 1); ++b)
-        for (int c = std::max(0, cz - 1); c <= std::min(grid.dims[2] - 1, cz + 1); ++c) {
-          const std::size_t cell = (std::size_t(a) * std::size_t(grid.dims[1]) + std::size_t(b)) * std::size_t(grid.dims[2]) + std::size_t(c);
-          for (std::int32_t m = grid.start[cell]; m < grid.start[cell + 1]; ++m) {
-            const std::int32_t j = grid.members[std::size_t(m)];
-            // Members of one clump never touch: the clump is rigid.
-            if (j <= std::int32_t(i) || (body >= 0 && s.body[std::size_t(j)] == body)) continue;
-            const double reach = s.radius[i] + s.radius[std::size_t(j)] + model.skin;
-            if ((s.x[std::size_t(j)] - xi).squaredNorm() < reach * reach) buffer.push_back(j);
-          }
+    std::vector<std::int32_t> buffer, apart;
+#pragma omp for schedule(dynamic, 1)
+    for (std::size_t chunk = 0; chunk < rows.by_chunk.size(); ++chunk) {
+      buffer.clear();
+      for (std::size_t i = chunk * FoundRows::chunk; i < std::min(s.owned(), (chunk + 1) * FoundRows::chunk); ++i) {
+        if (!s.active[i]) continue;
+        const Vec3& xi = s.x[i];
+        const std::int32_t body = s.body[i];
+        const int cx = grid.cell_coord(xi.x(), 0), cy = grid.cell_coord(xi.y(), 1), cz = grid.cell_coord(xi.z(), 2);
+        const std::size_t begin = buffer.size();
+        for (int a = std::max(0, cx - 1); a <= std::min(grid.dims[0] - 1, cx + 1); ++a)
+          for (int b = std::max(0, cy - 1); b <= std::min(grid.dims[1] - 1, cy + 1); ++b)
+            for (int c = std::max(0, cz - 1); c <= std::min(grid.dims[2] - 1, cz + 1); ++c) {
+              const std::size_t cell = (std::size_t(a) * std::size_t(grid.dims[1]) + std::size_t(b)) * std::size_t(grid.dims[2]) + std::size_t(c);
+              for (std::int32_t m = grid.start[cell]; m < grid.start[cell + 1]; ++m) {
+                const std::int32_t j = grid.members[std::size_t(m)];
+                // Members of one clump never touch: the clump is rigid.
+                if (j <= std::int32_t(i) || (body >= 0 && s.body[std::size_t(j)] == body)) continue;
+                const double reach = s.radius[i] + s.radius[std::size_t(j)] + model.skin;
+                if ((s.x[std::size_t(j)] - xi).squaredNorm() < reach * reach) buffer.push_back(j);
+              }
+            }
+        // Pairs touching now first, then the others, each part ascending: the force loop tests every
+        // listed pair for contact, and contacts last thousands of steps, so the outcome runs in two
+        // predictable stretches per row instead of at random (a mispredicted branch per pair cost
+        // about a tenth of the force loop).
+        // (In place, with the apart ones kept aside in the thread's own list: std::stable_partition
+        // allocated a buffer per row.)
+        const auto row = buffer.begin() + std::ptrdiff_t(begin);
+        std::sort(row, buffer.end());
+        auto kept = row;
+        apart.clear();
+        for (auto it = row; it != buffer.end(); ++it) {
+          const double reach = s.radius[i] + s.radius[std::size_t(*it)];
+          if ((s.x[std::size_t(*it)] - xi).squaredNorm() < reach * reach) *kept++ = *it;
+          else apart.push_back(*it);
         }
-    // Pairs touching now first, then the others, each part ascending: the force loop tests every
-    // listed pair for contact, and contacts last thousands of steps, so the outcome runs in two
-    // predictable stretches per row instead of at random (a mispredicted branch per pair cost
-    // about a tenth of the force loop).
-    // (In place, with the apart ones kept aside in the thread's own list: std::stable_partition
-    // allocated a buffer per row.)
-    const auto row = buffer.begin() + std::ptrdiff_t(begin);
-    std::sort(row, buffer.end());
-    auto kept = row;
-    apart.clear();
-    for (auto it = row; it != buffer.end(); ++it) {
-      const double reach = s.radius[i] + s.radius[std::size_t(*it)];
-      if ((s.x[std::size_t(*it)] - xi).squaredNorm() < reach * reach) *kept++ = *it;
-      else apart.push_back(*it);
+        std::copy(apart.begin(), apart.end(), kept);
+        rows.length[i] = std::int32_t(buffer.size() - begin);
+      }
+      rows.by_chunk[chunk].assign(buffer.begin(), buffer.end());
     }
-    std::copy(apart.begin(), apart.end(), kept);
-    rows.length[i] = std::int32_t(buffer.size() - begin);
-  }
   }
   return rows;
 }
@@ -368,8 +363,8 @@ void fill_list(NeighbourList& nl, const FoundRows& rows, const RowHistories& old
   refill(nl.rolling, rolling ? pairs : 0, Vec3f::Zero());
   refill(nl.touching, pairs, std::uint8_t(0));
 #pragma omp parallel for schedule(static)
-  for (std::size_t chunk = 0; chunk < rows.chunk_thread.size(); ++chunk) {
-    const std::int32_t* row = rows.by_thread[std::size_t(rows.chunk_thread[chunk])].data() + rows.chunk_begin[chunk];
+  for (std::size_t chunk = 0; chunk < rows.by_chunk.size(); ++chunk) {
+    const std::int32_t* row = rows.by_chunk[chunk].data();
     for (std::size_t i = chunk * FoundRows::chunk; i < std::min(n, (chunk + 1) * FoundRows::chunk); row += rows.length[i++]) {
       const auto history_begin = old.partner.begin() + old.start[i], history_end = old.partner.begin() + old.start[i + 1];
       for (std::int32_t k = 0, p = nl.row_start[i]; k < rows.length[i]; ++k, ++p) {
@@ -439,7 +434,7 @@ void rebuild_neighbours(const Model& model, State& s) {
     if (s.exchange) s.exchange->reordered(new_index);
     rename_members(grid, new_index);
     const RowHistories old = take_old_histories(s, new_index, tangential, rolling);
-    const FoundRows rows = scan_rows(model, s, std::move(grid), nl.partner.size());
+    const FoundRows rows = scan_rows(model, s, std::move(grid));
     fill_list(nl, rows, old, tangential, rolling);
   }  // the scratch is freed before the cross pairs are indexed
   const std::size_t n = s.size();
