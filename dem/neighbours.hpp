@@ -1,8 +1,7 @@
 #pragma once
 // Neighbour search: a cell grid over the domain builds a Verlet half list with a skin, rebuilt
-// once the largest displacement since the last build (particles relative to each other, or to a
-// moving wall; measured from the positions at the build as kept, plus their rounding) may exceed
-// half the skin. Contact history survives rebuilds.
+// exactly when the largest displacement since the last build (particles relative to each
+// other, or to a moving wall) exceeds half the skin. Contact history survives rebuilds.
 // Particles are re-sorted along the cells at every rebuild, for memory locality. O(N).
 #include "dem/model.hpp"
 #include "dem/state.hpp"
