@@ -42,7 +42,8 @@ nlohmann::json read_json(const fs::path& file) {
 
 // 4,000 of the scene's grains in a box of planes 20 grains wide, inserted as densely as random
 // insertion goes (a bed of grains in contact, as a fill's mostly is): 100 steps to start, then
-// the particle-steps per second of 300.
+// the particle-steps per second of the fastest of five blocks of 60 (another process that takes a
+// core for a moment slows a block, not the figure).
 double measure_kernel(const scene::PipelineScene& s, const GrainSizing& grains) {
   dem::ModelSpec spec = scene::coarse_grained_spec(s.spec, grains.alpha);
   const int powder = scene::powder_material(spec), steel = scene::tool_material(spec);
@@ -65,9 +66,13 @@ double measure_kernel(const scene::PipelineScene& s, const GrainSizing& grains) 
   const dem::Model model = dem::compile_model(spec, state, "throughput kernel");
   dem::initialize(model, state);
   for (int n = 0; n < 100; ++n) dem::step(model, state);
-  diefill::Stopwatch clock;
-  for (int n = 0; n < 300; ++n) dem::step(model, state);
-  return 300.0 * double(state.size()) / clock.seconds();
+  double fastest = 0;
+  for (int block = 0; block < 5; ++block) {
+    const diefill::Stopwatch clock;
+    for (int n = 0; n < 60; ++n) dem::step(model, state);
+    fastest = std::max(fastest, 60.0 * double(state.size()) / clock.seconds());
+  }
+  return fastest;
 }
 
 }  // namespace
@@ -81,15 +86,18 @@ double kernel_rate(const scene::PipelineScene& s, const GrainSizing& grains, con
   const fs::path file = cache / "throughput.json";
   nlohmann::json rates = read_json(file);
   const std::string key = machine_key(threads_of(s));
-  if (rates.contains(key)) return rates[key].get<double>();
-  const double rate = [&] {
+  const double measured = [&] {
     const ThreadCount threads(threads_of(s));
     return measure_kernel(s, grains);
   }();
-  rates[key] = rate;
+  // The fastest this machine has shown is kept: measured once and kept, a rate taken beside
+  // another busy process (3 to 35 times below the idle machine's beside a test) lengthened every
+  // later plan on the machine.
+  if (rates.contains(key) && rates[key].get<double>() >= measured) return rates[key].get<double>();
+  rates[key] = measured;
   fs::create_directories(cache);
   diefill::write_file_atomic(file, rates.dump(2) + "\n");
-  return rate;
+  return measured;
 }
 
 TimeModel time_model(const fs::path& cache, double rate) {

@@ -1,8 +1,9 @@
 #pragma once
 // How fast this machine runs a scene, for `diefill plan` (pipeline/run_plan.hpp): a kernel rate
-// measured once per machine, thread count and DEM code (the scene's powder poured in a box for a
-// few hundred steps; cached), and a wall-time model, time = overhead + particle-steps / (rate ×
-// efficiency), whose two constants every finished run on this machine refines (timings.jsonl).
+// measured at every plan (the scene's powder poured in a box for a few hundred steps), the
+// fastest per machine, thread count and DEM code kept, and a wall-time model, time = overhead +
+// particle-steps / (rate × efficiency), whose two constants every finished run on this machine
+// refines (timings.jsonl).
 #include <filesystem>
 #include <string>
 
@@ -10,8 +11,9 @@
 
 namespace pipeline {
 
-// The kernel's particle-steps per second at the scene's thread count, from `cache` when measured
-// before on this machine (its processor, thread count and the DEM's source hash).
+// The kernel's particle-steps per second at the scene's thread count: measured (about a second),
+// or the fastest measured before on this machine (its processor, thread count and the DEM's
+// source hash) as `cache` keeps it, if faster.
 double kernel_rate(const scene::PipelineScene& scene, const GrainSizing& grains, const std::filesystem::path& cache);
 
 // The defaults: fitted to six runs from fresh shoes on the development machine (ring and disc at

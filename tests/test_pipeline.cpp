@@ -20,6 +20,7 @@
 #include "pipeline/density_stage.hpp"
 #include "pipeline/die_fill.hpp"
 #include "pipeline/sweep.hpp"
+#include "pipeline/throughput.hpp"
 #include "core/error.hpp"
 #include "scene/pipeline_scene.hpp"
 #include "dem/io.hpp"
@@ -751,11 +752,17 @@ TEST(PipelineOwnRuns, SeedEnsembleIsTheMeanOfItsSeedsRuns) {
 // `diefill plan` on the ring (docs/INTERFACE.md, "Plans"): every grain size's run as `diefill
 // scene` sizes it (the default's 16,042 grains and 79,957 pass steps), a predicted time for each,
 // the annulus as the narrowest part (5 mm), the sizes with fewer than five grains across it
-// marked, and a chosen command.
+// marked, and a chosen command. The cache holds the development machine's kernel rate on two idle
+// threads (AMD EPYC, 1.55e7 particle-steps per second), so that the plan does not depend on what
+// else runs beside the test: measured beside another test, the rate came out 2 to 35 times lower,
+// and no run fitted the budget.
 TEST(PipelineOwnRuns, PlanPredictsEachGrainSizesRunAndChoosesOne) {
   const fs::path dir = suite_out() / "plan";
+  fs::remove_all(dir);
+  fs::create_directories(dir / ".cache");
+  test::write_text(dir / ".cache" / "throughput.json", nlohmann::json{{pipeline::machine_key(2), 1.55e7}}.dump());
   const test::Run r = test::run_diefill("plan " + bundled_die("ring").string() + " --out " + dir.string() + " --json " +
-                                        (dir / "plan.json").string() + " --accuracy 0.02 --budget 10m");
+                                        (dir / "plan.json").string() + " --accuracy 0.02 --budget 10m --threads 2");
   ASSERT_EQ(r.status, 0) << r.output;
   const nlohmann::json plan = nlohmann::json::parse(read_text(dir / "plan.json"));
   EXPECT_NEAR(plan["narrowest_tenth_m"].get<double>(), 5e-3, 0.3e-3);
@@ -773,4 +780,24 @@ TEST(PipelineOwnRuns, PlanPredictsEachGrainSizesRunAndChoosesOne) {
   ASSERT_FALSE(plan["chosen"].is_null()) << r.output;
   EXPECT_TRUE(plan["chosen"]["command"].get<std::string>().starts_with("diefill run ")) << plan["chosen"].dump();
   EXPECT_LE(plan["chosen"]["predicted_wall_s"].get<double>(), 600);
+  EXPECT_GE(plan["machine"]["kernel_particle_steps_per_s"].get<double>(), 1.55e7);
+}
+
+// The cache keeps the fastest kernel rate the machine has shown: a measurement slower than the
+// kept figure leaves it (and the plan takes the kept one), a faster one replaces it.
+TEST(Throughput, TheCacheKeepsTheFastestRateMeasured) {
+  const scene::PipelineScene scene = scene::load_pipeline_scene(std::nullopt, {"simulation.threads=2"});
+  const double d = scene.powder.grain_diameter();
+  const pipeline::GrainSizing grains{d, 0.5 * d, scene.powder.coarse_graining, 0};
+  const fs::path cache = suite_out() / "kernel_rate";
+  fs::create_directories(cache);
+  const auto kept = [&] { return nlohmann::json::parse(read_text(cache / "throughput.json"))[pipeline::machine_key(2)].get<double>(); };
+  const auto keep = [&](double rate) { test::write_text(cache / "throughput.json", nlohmann::json{{pipeline::machine_key(2), rate}}.dump()); };
+  keep(1e15);  // no machine measures this fast
+  EXPECT_EQ(pipeline::kernel_rate(scene, grains, cache), 1e15);
+  EXPECT_EQ(kept(), 1e15);
+  keep(1);  // nor this slow
+  const double measured = pipeline::kernel_rate(scene, grains, cache);
+  EXPECT_GT(measured, 1);
+  EXPECT_EQ(kept(), measured);
 }
