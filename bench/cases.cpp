@@ -318,11 +318,12 @@ Bed tiled_bed(const dem::State& tile, double side, int across, int along) {
 // `bed` stepped until it rests by the LIGGGHTS preparation's own criterion (mean kinetic energy per
 // grain below 1e-12 J, ../shared/bench/liggghts/in/prep.in), kept at `path` as a checkpoint with its
 // contact histories, so that the timed steps go on from a bed at rest. Made once per bed (its
-// positions, histories and model are the file's hash) in `cache`; under MPI by rank 0 alone.
+// positions, histories, model and the checkpoints' layout are the file's hash) in `cache`; under
+// MPI by rank 0 alone.
 dem::State settled_bed(const Bed& unsettled, const fs::path& cache, const std::string& name, const std::shared_ptr<dem::Exchange>& ranks) {
   const dem::Model& model = unsettled.model;
   const auto bytes = [](const auto& array) { return std::string_view(reinterpret_cast<const char*>(array.data()), array.size() * sizeof(array[0])); };
-  const std::string key = diefill::sha256_hex(model.hash + diefill::sha256_hex(bytes(unsettled.grains.x)) +
+  const std::string key = diefill::sha256_hex(dem::checkpoint_layout() + model.hash + diefill::sha256_hex(bytes(unsettled.grains.x)) +
                                               diefill::sha256_hex(bytes(unsettled.grains.neighbours.tangential)));
   const fs::path path = cache / fmt::format("scaling_{}_{}.ckpt", name, key.substr(0, 16));
   if (!fs::exists(path) && (!ranks || ranks->rank() == 0)) {

@@ -346,6 +346,8 @@ State read_checkpoint(const Model& model, const std::filesystem::path& path, std
   return s;
 }
 
+std::string checkpoint_layout() { return std::string(magic, sizeof magic); }
+
 void remove_checkpoint(const std::filesystem::path& path) {
   remove_pieces(path, 0);
   fs::remove(path);

@@ -11,6 +11,7 @@
 // same statistics, not the same bits.
 #include <filesystem>
 #include <memory>
+#include <string>
 
 #include "dem/model.hpp"
 #include "dem/state.hpp"
@@ -23,6 +24,10 @@ void write_checkpoint(const Model& model, const State& state, const std::filesys
 // exchange (every rank reads the file), this rank's share, ready to step; without, the whole
 // state of a single-process checkpoint.
 State read_checkpoint(const Model& model, const std::filesystem::path& path, std::shared_ptr<Exchange> exchange = nullptr);
+
+// The layout's name, written at the head of every single-process checkpoint: a cache of
+// checkpoints keyed by it is written anew when the layout changes (bench/cases.cpp).
+std::string checkpoint_layout();
 
 // Removes a checkpoint and its pieces.
 void remove_checkpoint(const std::filesystem::path& path);
