@@ -309,8 +309,8 @@ Bed tiled_bed(const dem::State& tile, double side, int across, int along) {
       nl.row_start.push_back(nl.row_start.back() + listed.row_start[i + 1] - listed.row_start[i]);
     }
     for (const std::int32_t j : listed.partner) nl.partner.push_back(first + j);
-    for (const dem::Vec3& spring : listed.tangential) nl.tangential.push_back(place(spring));
-    for (const dem::Vec3& torque : listed.rolling) nl.rolling.push_back(turn(torque));
+    for (const dem::Vec3f& spring : listed.tangential) nl.tangential.push_back(place(spring.cast<double>()).cast<float>());
+    for (const dem::Vec3f& torque : listed.rolling) nl.rolling.push_back(turn(torque.cast<double>()).cast<float>());
   }
   return {boxed_model(bed, side, across, along), bed};
 }

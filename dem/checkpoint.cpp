@@ -17,9 +17,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr char magic[8] = {'D', 'F', 'C', 'K', 'P', 'T', '0', '9'};
+constexpr char magic[8] = {'D', 'F', 'C', 'K', 'P', 'T', '1', '0'};
 constexpr char split_magic[8] = {'D', 'F', 'C', 'K', 'S', 'P', '0', '4'};
-constexpr char piece_magic[8] = {'D', 'F', 'C', 'K', 'P', 'C', '0', '6'};
+constexpr char piece_magic[8] = {'D', 'F', 'C', 'K', 'P', 'C', '0', '7'};
 
 // Streams straight into the file: a rank's piece of ten million grains is never held twice.
 struct Writer {

@@ -118,8 +118,8 @@ void for_each_history(const State& s, Use use) {
   }
   for (std::size_t i = 0; i < owned; ++i)
     for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p) {
-      const Vec3 t = nl.tangential.empty() ? Vec3::Zero() : nl.tangential[std::size_t(p)];
-      const Vec3 r = nl.rolling.empty() ? Vec3::Zero() : nl.rolling[std::size_t(p)];
+      const Vec3f t = nl.tangential.empty() ? Vec3f::Zero() : nl.tangential[std::size_t(p)];
+      const Vec3f r = nl.rolling.empty() ? Vec3f::Zero() : nl.rolling[std::size_t(p)];
       if (t.squaredNorm() == 0 && r.squaredNorm() == 0) continue;
       const std::size_t j = std::size_t(nl.partner[std::size_t(p)]);
       use(i, std::int64_t(j), CarriedPair{s.id[i], s.id[j], t, r});

@@ -22,7 +22,7 @@ struct State;
 // rank when it migrates.
 struct CarriedPair {
   std::int64_t id, partner;
-  Vec3 tangential, rolling;
+  Vec3f tangential, rolling;
 };
 
 // A grain as it travels between ranks (a ghost's copy, or a grain gathered for the outputs).

@@ -130,8 +130,8 @@ double apply_batch(const ContactBatch& b, State& s) {
       s.cross_forces.force[std::size_t(b.slot[k])] = -force;
       s.cross_forces.torque[std::size_t(b.slot[k])] = partner_torque;
     }
-    if constexpr (Law::keeps_tangential) nl.tangential[p] = Vec3(b.tx[k], b.ty[k], b.tz[k]);
-    if constexpr (Law::keeps_rolling) nl.rolling[p] = Vec3(b.rx[k], b.ry[k], b.rz[k]);
+    if constexpr (Law::keeps_tangential) nl.tangential[p] = Vec3(b.tx[k], b.ty[k], b.tz[k]).cast<float>();
+    if constexpr (Law::keeps_rolling) nl.rolling[p] = Vec3(b.rx[k], b.ry[k], b.rz[k]).cast<float>();
     max_overlap = std::max(max_overlap, b.overlap_rel[k]);
   }
   f[row] = row_force, torque[row] = row_torque;
@@ -282,11 +282,11 @@ void pair_forces(const Model& model, State& s) {
             b.vix[k] = vi.x(), b.viy[k] = vi.y(), b.viz[k] = vi.z(), b.wix[k] = wi.x(), b.wiy[k] = wi.y(), b.wiz[k] = wi.z();
             b.vjx[k] = vj.x(), b.vjy[k] = vj.y(), b.vjz[k] = vj.z(), b.wjx[k] = wj.x(), b.wjy[k] = wj.y(), b.wjz[k] = wj.z();
             if constexpr (Law::keeps_tangential) {
-              const Vec3& h = nl.tangential[std::size_t(p)];
+              const Vec3f& h = nl.tangential[std::size_t(p)];
               b.tx[k] = h.x(), b.ty[k] = h.y(), b.tz[k] = h.z();
             }
             if constexpr (Law::keeps_rolling) {
-              const Vec3& h = nl.rolling[std::size_t(p)];
+              const Vec3f& h = nl.rolling[std::size_t(p)];
               b.rx[k] = h.x(), b.ry[k] = h.y(), b.rz[k] = h.z();
             }
             if (!common) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numbers>
 
@@ -64,6 +65,14 @@ bool reads_key(const ContactLawChoice& choice, std::string_view key) {
   for (const SlotLaw& law : slot_laws())
     if (choice[law.slot] == law.name && law.reads.find(key) != std::string_view::npos) return true;
   return false;
+}
+
+// Rounding a coordinate c to single precision moves it by at most half the spacing of floats at
+// |c|; within the domain that is largest at its farthest corner, on each of the three axes.
+double build_position_rounding(const Box3& domain) {
+  const auto farthest = float(domain.lo.cwiseAbs().cwiseMax(domain.hi.cwiseAbs()).maxCoeff());
+  const double spacing = double(std::nextafter(farthest, std::numeric_limits<float>::infinity())) - double(farthest);
+  return std::sqrt(3.0) * 0.5 * spacing;
 }
 
 }  // namespace
@@ -183,6 +192,14 @@ Model compile_model(const ModelSpec& spec, const State& state, const std::string
     const MeshWall& w = spec.meshes[k];
     check_wall_travel(w.name, w.motion.top_speed() + w.motion.angular_velocity.norm() * m.mesh_reach[k], m.dt, m.skin, source);
   }
+  m.build_position_rounding = build_position_rounding(m.domain);
+  // It takes its share of the half skin from every grain's travel between rebuilds.
+  if (m.build_position_rounding > 0.1 * m.skin)
+    throw InputError(source, "domain", fmt::format("a box reaching {:.3g} m from the origin holds positions to only {:.3g} m in "
+                                                   "the neighbour list's single precision, over a tenth of the skin {:.3g} m",
+                                                   m.domain.lo.cwiseAbs().cwiseMax(m.domain.hi.cwiseAbs()).maxCoeff(),
+                                                   m.build_position_rounding, m.skin),
+                     "Place the scene near the origin and give a domain that just holds it");
   m.cell_size = 2 * m.max_radius + m.skin;
 
   std::string text = fmt::format("dt={:a};skin={:a};g={:a},{:a},{:a};laws={}+{}+{}+{};stop={:a};dom={:a},{:a},{:a},{:a},{:a},{:a}",

@@ -104,6 +104,10 @@ struct Model {
   double dt_rayleigh;           // [s] smallest Rayleigh time of the particles
   double dt_hertz;              // [s] Hertz collision time at max_impact_speed
   double skin;                  // [m]
+  // [m] The farthest a grain in the domain lies from its rounded position at the last list build
+  // (NeighbourList::x_at_build): the displacement check adds it, so that it bounds the shift from
+  // the exact positions the list was built on, the same bound on every rank.
+  double build_position_rounding;
   double cell_size;             // [m] neighbour grid
   double max_radius;            // [m]
   Box3 domain;

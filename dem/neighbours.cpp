@@ -164,7 +164,7 @@ void carry_wall_slots(State& s, const Array<std::int32_t>& old_near, const Array
 
 struct OldPair {
   std::int32_t i, j;
-  Vec3 tangential, rolling;
+  Vec3f tangential, rolling;
 };
 
 // Particles per block (state.hpp, NeighbourList): a function of their number only, so that the
@@ -206,7 +206,7 @@ void index_cross_pairs(NeighbourList& nl, std::size_t n, std::size_t owned) {
 // them is held in between; each row keeps the order `visit` gives.
 struct RowHistories {
   std::vector<std::int32_t> start, partner;
-  Array<Vec3> tangential, rolling;
+  Array<Vec3f> tangential, rolling;
 };
 template <typename Visit>
 void histories_by_row(std::size_t n, bool tangential, bool rolling, Visit visit, RowHistories& h) {
@@ -239,8 +239,8 @@ void visit_listed_histories(const NeighbourList& nl, const std::vector<std::int3
   const auto now = [&](std::size_t i) { return renumbered.empty() ? new_index[i] : renumbered[i] < 0 ? -1 : new_index[std::size_t(renumbered[i])]; };
   for (std::size_t i = 0; i + 1 < nl.row_start.size(); ++i)
     for (std::int32_t p = nl.row_start[i]; p < nl.row_start[i + 1]; ++p) {
-      const Vec3 t = nl.tangential.empty() ? Vec3::Zero() : nl.tangential[std::size_t(p)];
-      const Vec3 r = nl.rolling.empty() ? Vec3::Zero() : nl.rolling[std::size_t(p)];
+      const Vec3f t = nl.tangential.empty() ? Vec3f::Zero() : nl.tangential[std::size_t(p)];
+      const Vec3f r = nl.rolling.empty() ? Vec3f::Zero() : nl.rolling[std::size_t(p)];
       if (t.squaredNorm() == 0 && r.squaredNorm() == 0) continue;
       if (const std::int32_t a = now(i), b = now(std::size_t(nl.partner[std::size_t(p)])); a >= 0 && b >= 0) add(OldPair{a, b, t, r});
     }
@@ -359,8 +359,8 @@ void fill_list(NeighbourList& nl, const FoundRows& rows, const RowHistories& old
   for (std::size_t i = 0; i < n; ++i) nl.row_start[i + 1] = nl.row_start[i] + rows.length[i];
   const std::size_t pairs = std::size_t(nl.row_start[n]);
   refill(nl.partner, pairs, 0);
-  refill(nl.tangential, tangential ? pairs : 0, Vec3::Zero());
-  refill(nl.rolling, rolling ? pairs : 0, Vec3::Zero());
+  refill(nl.tangential, tangential ? pairs : 0, Vec3f::Zero());
+  refill(nl.rolling, rolling ? pairs : 0, Vec3f::Zero());
   refill(nl.touching, pairs, std::uint8_t(0));
 #pragma omp parallel for schedule(static)
   for (std::size_t chunk = 0; chunk < rows.by_chunk.size(); ++chunk) {
@@ -397,7 +397,7 @@ bool needs_rebuild(const Model& model, const State& s, double largest_shift2) {
     const double turned = motion.angular_velocity.norm() * std::abs(s.time - nl.time_at_build) * model.mesh_reach[m];
     wall_shift = std::max(wall_shift, (motion.position(s.time) - nl.wall_shift_at_build[m]).norm() + turned);
   }
-  return std::sqrt(largest_shift2) + wall_shift > 0.5 * model.skin;
+  return std::sqrt(largest_shift2) + model.build_position_rounding + wall_shift > 0.5 * model.skin;
 }
 
 void lose_outside_domain(const Model& model, State& s) {
@@ -442,7 +442,8 @@ void rebuild_neighbours(const Model& model, State& s) {
   refill(s.cross_forces.force, nl.cross_reverse.size(), Vec3::Zero());
   refill(s.cross_forces.torque, nl.cross_reverse.size(), Vec3::Zero());
 
-  nl.x_at_build = s.x;
+  nl.x_at_build.resize(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) nl.x_at_build[i] = s.x[i].cast<float>();
   nl.time_at_build = s.time;
   nl.wall_shift_at_build.resize(model.meshes.size());
   for (std::size_t m = 0; m < model.meshes.size(); ++m) nl.wall_shift_at_build[m] = model.meshes[m].motion.position(s.time);

@@ -1,7 +1,8 @@
 #pragma once
 // Neighbour search: a cell grid over the domain builds a Verlet half list with a skin, rebuilt
-// exactly when the largest displacement since the last build (particles relative to each
-// other, or to a moving wall) exceeds half the skin. Contact history survives rebuilds.
+// once the largest displacement since the last build (particles relative to each other, or to a
+// moving wall; measured from the positions at the build as kept, plus their rounding) may exceed
+// half the skin. Contact history survives rebuilds.
 // Particles are re-sorted along the cells at every rebuild, for memory locality. O(N).
 #include "dem/model.hpp"
 #include "dem/state.hpp"

@@ -49,15 +49,15 @@ struct WallCandidates {
 struct NeighbourList {
   Array<std::int32_t> row_start;      // [N+1] pairs of particle i: [row_start[i], row_start[i+1])
   Array<std::int32_t> partner;        // [P] j > i
-  Array<Vec3> tangential;             // [P] Mindlin spring ξ [m]; empty without tangential friction
-  Array<Vec3> rolling;                // [P] EPSD torque [N m]; empty unless the rolling law is EPSD
+  Array<Vec3f> tangential;            // [P] Mindlin spring ξ [m]; empty without tangential friction
+  Array<Vec3f> rolling;               // [P] EPSD torque [N m]; empty unless the rolling law is EPSD
   Array<std::uint8_t> touching;       // [P] 1 while the pair is in contact
   std::int32_t block_size = 1;              // particles per block
   Array<std::int32_t> cross_start;    // [N+1] cross pairs of row i: buffer slots [cross_start[i], cross_start[i+1])
   Array<std::int32_t> cross_reverse_start;  // [N+1] cross slots naming particle j as partner
   Array<std::int32_t> cross_reverse;  // [C] those slots, ascending
   Array<std::int32_t> near_wall;      // particles within range of a wall at build time
-  Array<Vec3> x_at_build;             // [N] [m]
+  Array<Vec3f> x_at_build;            // [N] [m], rounded (Model::build_position_rounding)
   Array<Vec3> wall_shift_at_build;    // [mesh walls] [m] wall origin at build time
   double time_at_build = 0;                 // [s]
   std::int64_t builds = 0;

@@ -38,7 +38,7 @@ double kick_and_drift(State& s, double half_dt, double dt) {
   kick_bodies(s, half_dt);
   drift_bodies(s, dt);
   const std::size_t n = s.owned();
-  const Array<Vec3>& built = s.neighbours.x_at_build;
+  const Array<Vec3f>& built = s.neighbours.x_at_build;
   const bool listed = built.size() == s.size();
   // No list (a state read back or shared anew): every rank rebuilds, one holding no grain too.
   double largest = listed ? 0 : std::numeric_limits<double>::infinity();
@@ -50,7 +50,7 @@ double kick_and_drift(State& s, double half_dt, double dt) {
       s.w[i] += (half_dt / sphere_inertia(s.mass[i], s.radius[i])) * s.torque[i];
       s.x[i] += dt * s.v[i];
     }
-    if (listed) largest = std::max(largest, (s.x[i] - built[i]).squaredNorm());
+    if (listed) largest = std::max(largest, (s.x[i] - built[i].cast<double>()).squaredNorm());
   }
   return largest;
 }

@@ -32,8 +32,8 @@ Histories histories_by_id(const dem::State& s) {
       const std::size_t j = std::size_t(nl.partner[std::size_t(p)]);
       const double sign = s.id[i] < s.id[j] ? 1.0 : -1.0;
       dem::ContactHistory h;
-      h.tangential = sign * nl.tangential[std::size_t(p)];
-      h.rolling = sign * nl.rolling[std::size_t(p)];
+      h.tangential = sign * nl.tangential[std::size_t(p)].cast<double>();
+      h.rolling = sign * nl.rolling[std::size_t(p)].cast<double>();
       out[{std::min(s.id[i], s.id[j]), std::max(s.id[i], s.id[j])}] = h;
     }
   return out;
