@@ -14,13 +14,17 @@ namespace pipeline {
 namespace {
 
 // Two grains, the smallest and the largest the size distribution draws: the model's time step is
-// the smallest Rayleigh and collision time over its grains, and its skin follows the largest.
-dem::Model compile_on_stand_ins(const dem::ModelSpec& spec, double diameter, double spread, const std::string& source) {
+// the smallest Rayleigh and collision time over its grains, and its skin follows the largest. In
+// a domain that just holds them, as a run's holds its grains: the model checks the skin against
+// how finely single precision places a grain in its domain (dem/model.cpp), and the default's
+// metre would refuse a skin a run's domain takes.
+dem::Model compile_on_stand_ins(dem::ModelSpec spec, double diameter, double spread, const std::string& source) {
   const int powder = scene::powder_material(spec);
   dem::State stand_ins;
   const double density = spec.materials[std::size_t(powder)].density;
   stand_ins.add_sphere(0, dem::Vec3::Zero(), 0.5 * diameter * (1 - spread), density, powder);
-  stand_ins.add_sphere(1, dem::Vec3::UnitX(), 0.5 * diameter * (1 + spread), density, powder);
+  stand_ins.add_sphere(1, dem::Vec3(2 * diameter, 0, 0), 0.5 * diameter * (1 + spread), density, powder);
+  spec.domain = {dem::Vec3::Constant(-2 * diameter), dem::Vec3::Constant(4 * diameter)};
   return dem::compile_model(spec, stand_ins, source);
 }
 
