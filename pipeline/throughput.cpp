@@ -91,9 +91,9 @@ double kernel_rate(const scene::PipelineScene& s, const GrainSizing& grains, con
     return measure_kernel(s, grains);
   }();
   // The fastest this machine has shown is kept: measured once and kept, a rate taken beside
-  // another busy process (3 to 35 times below the idle machine's beside a test) lengthened every
+  // another busy process (2 to 35 times below the idle machine's beside a test) lengthened every
   // later plan on the machine.
-  if (rates.contains(key) && rates[key].get<double>() >= measured) return rates[key].get<double>();
+  if (const double kept = rates.value(key, 0.0); kept >= measured) return kept;
   rates[key] = measured;
   fs::create_directories(cache);
   diefill::write_file_atomic(file, rates.dump(2) + "\n");

@@ -104,8 +104,8 @@ TEST(Study, ReposeAnglesRiseWithFrictionNearTheZhouCorrelation) {
 
 // Coarse graining (docs/PHYSICS.md §4) at grains of 0.8, 1.13 and 1.6 mm in a slot container
 // that holds the coarsest eight across its slot and ten across its width, 4, 6 and 16 beds (each
-// size's mean about as noisy as the others'); reduced, the ring die is not filled. Both checks
-// held for every draw of the seed tried (docs/STUDIES.md, "coarse-graining").
+// size's mean about as noisy as the others'); reduced, the ring die is not filled. With 2, 6 and
+// 16 beds both checks held for six draws of the seed of six (docs/STUDIES.md, "coarse-graining").
 TEST(Study, CoarseGrainingKeepsFlowAndReposeOnceTheBoundaryIsCorrected) {
   const nlohmann::json r = run_reduced("coarse-graining", {});
   const auto& inv = r["invariance"];
