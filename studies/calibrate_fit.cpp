@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
+#include <utility>
 #include <nlohmann/json.hpp>
 
 #include "core/atomic_file.hpp"
@@ -132,6 +134,22 @@ Vector2 best_frictions(const std::vector<ObservableFit>& obs) {
   return p;
 }
 
+// The combinations of the frictions the measurements fix best and worst: the eigenvectors of
+// their information, each 95 % half-width 1.96 / √(its eigenvalue); written with the larger of
+// the two weights positive.
+std::pair<FrictionCombination, FrictionCombination> fixed_combinations(const Matrix2& data) {
+  const Eigen::SelfAdjointEigenSolver<Matrix2> eigen(data);  // eigenvalues ascending
+  const double largest = eigen.eigenvalues()[1];
+  const auto combination = [&](int k) {
+    Vector2 weights = eigen.eigenvectors().col(k);
+    if (weights[std::abs(weights[0]) >= std::abs(weights[1]) ? 0 : 1] < 0) weights = -weights;
+    const double lambda = eigen.eigenvalues()[k];
+    const bool fixed = lambda > 0 && lambda > 1e-12 * largest;
+    return FrictionCombination{weights[0], weights[1], fixed ? 1.96 / std::sqrt(lambda) : std::numeric_limits<double>::infinity()};
+  };
+  return {combination(1), combination(0)};
+}
+
 }  // namespace
 
 CalibrationFit fit_frictions(const std::vector<Finished>& tests, const MeasuredPowder& measured, const SimulatedTests& simulated) {
@@ -153,6 +171,7 @@ CalibrationFit fit_frictions(const std::vector<Finished>& tests, const MeasuredP
   fit.rolling_data_ci = data_ci[1];
   fit.sliding_pinned = data_ci[0] <= pinned_within;
   fit.rolling_pinned = data_ci[1] <= pinned_within;
+  std::tie(fit.best_fixed, fit.least_fixed) = fixed_combinations(data);
   const auto within = [&](double x, double DesignPoint::*along) {
     const auto [lo, hi] = std::minmax_element(tests.begin(), tests.end(),
                                               [&](const Finished& a, const Finished& b) { return a.point.*along < b.point.*along; });
@@ -175,10 +194,17 @@ std::string confidence_line(const char* name, double value, double ci, double da
                      name, value, ci, data_ci, pinned_within);
 }
 
+std::string combination_text(const FrictionCombination& c) {
+  return fmt::format("{:.2f} μ {} {:.2f} μ_r", c.sliding, c.rolling < 0 ? "-" : "+", std::abs(c.rolling));
+}
+std::string half_width_text(double ci) { return std::isfinite(ci) ? fmt::format("± {:.3g}", ci) : "nothing"; }
+
 std::string calibrated_toml(const MeasuredPowder& m, const CalibrationFit& fit) {
   std::string out = fmt::format("# diefill calibrate {}: the powder for a scene (docs/INTERFACE.md, \"Your powder\").\n", m.source);
   out += confidence_line("sliding_friction", fit.sliding, fit.sliding_ci, fit.sliding_data_ci, fit.sliding_pinned);
   out += confidence_line("rolling_friction", fit.rolling, fit.rolling_ci, fit.rolling_data_ci, fit.rolling_pinned);
+  out += fmt::format("# the measurements alone fix {} to {} and {} to {} (95 %)\n", combination_text(fit.best_fixed),
+                     half_width_text(fit.best_fixed.ci), combination_text(fit.least_fixed), half_width_text(fit.least_fixed.ci));
   if (!fit.inside_design) out += "# outside the tested design (μ 0.2-0.8, μ_r 0-0.3): extrapolated by the maps\n";
   for (const ObservableFit& o : fit.observables)
     out += o.used ? fmt::format("# {}: measured {:.4g}, fitted {:.4g} ({:+.2f} standard errors)\n", o.name, o.measured, o.fitted, o.residual)
@@ -196,11 +222,15 @@ nlohmann::json fit_json(const CalibrationFit& fit) {
                            {"left_out", o.left_out}, {"model_error", o.model_error}, {"map", o.coefficients}, {"scatter", o.scatter}, {"fitted", o.fitted},
                            {"residual", o.residual}});
   const auto finite_or_null = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
+  const auto combination_json = [&](const FrictionCombination& c) {
+    return nlohmann::json{{"sliding_weight", c.sliding}, {"rolling_weight", c.rolling}, {"measurements_ci95", finite_or_null(c.ci)}};
+  };
   return {{"sliding_friction", {{"value", fit.sliding}, {"ci95", fit.sliding_ci}, {"measurements_ci95", finite_or_null(fit.sliding_data_ci)},
                                 {"pinned", fit.sliding_pinned}}},
           {"rolling_friction", {{"value", fit.rolling}, {"ci95", fit.rolling_ci}, {"measurements_ci95", finite_or_null(fit.rolling_data_ci)},
                                 {"pinned", fit.rolling_pinned}}},
           {"pinned_within", pinned_within},
+          {"fixed_combinations", nlohmann::json::array({combination_json(fit.best_fixed), combination_json(fit.least_fixed)})},
           {"inside_design", fit.inside_design},
           {"observables", observables}};
 }

@@ -33,11 +33,22 @@ struct ObservableFit {
   double residual = 0;                      // (fitted − measured) in combined standard errors
 };
 
+// A combination a μ + b μ_r of the two frictions (a² + b² = 1) and the 95 % half-width to which the
+// measurements alone fix it (infinite: they do not fix it at all).
+struct FrictionCombination {
+  double sliding = 0, rolling = 0, ci = 0;
+};
+
 struct CalibrationFit {
   double sliding = 0, rolling = 0;
   double sliding_ci = 0, rolling_ci = 0;            // 95 % half-widths
   double sliding_data_ci = 0, rolling_data_ci = 0;  // the measurements' alone (infinite: they do not fix it)
   bool sliding_pinned = false, rolling_pinned = false;
+  // The combination the measurements fix best and, across it, the one they fix worst: a heap's
+  // angle and an orifice's flow both rise or fall with a weighted sum of the two frictions, so
+  // that they fix that sum and leave the frictions' split to what else was measured
+  // (docs/STUDIES.md, "calibration-round-trip").
+  FrictionCombination best_fixed, least_fixed;
   bool inside_design = true;
   std::vector<ObservableFit> observables;
 };

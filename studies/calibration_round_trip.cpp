@@ -72,6 +72,10 @@ void calibration_round_trip(const scene::PipelineScene& scene, bool reduced, Out
                                      {"flow_rate_error", measured.flow_rate_error}};
   for (const char* name : {"sliding_friction", "rolling_friction"})
     out.results[name]["error"] = out.results[name]["value"].get<double>() - (name[0] == 's' ? sliding : rolling);
+  // The same errors along the combinations the measurements fix best and worst.
+  for (nlohmann::json& combination : out.results["fixed_combinations"])
+    combination["error"] = combination["sliding_weight"].get<double>() * out.results["sliding_friction"]["error"].get<double>() +
+                           combination["rolling_weight"].get<double>() * out.results["rolling_friction"]["error"].get<double>();
 }
 
 }  // namespace studies
