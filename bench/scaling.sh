@@ -10,26 +10,34 @@
 # bench/results/scaling.json and the chart to docs/scaling.png.
 # SIZES: the grain counts to time (default all five). A bed not yet settled is settled first: all
 # five took about 50 minutes of both cores on an Intel Xeon kind, the 500k bed alone is over an
-# hour on an AMD EPYC Zen 1.
-#   bench/scaling.sh [REPEATS=3] [STEPS=2000] [SIZES="5000 15000 50000 150000 500000"]
+# hour on an AMD EPYC Zen 1. With `unsettled`, a bed of several tiles is timed as laid out of the
+# settled tiles, not settled again (`--unsettled-beds`: minutes instead of an hour); the contacts
+# per grain at the start and the end of the timed steps say how far it moved.
+#   bench/scaling.sh [REPEATS=3] [STEPS=2000] [SIZES="5000 15000 50000 150000 500000"] [unsettled]
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 repeats="${1:-3}"; steps="${2:-2000}"; size=50k
 read -r -a sizes <<< "${3:-5000 15000 50000 150000 500000}"
+unsettled=()
+case "${4:-}" in
+  unsettled) unsettled=(--unsettled-beds) ;;
+  "") ;;
+  *) echo "scaling.sh: the fourth argument is 'unsettled' or nothing, not '$4'" >&2; exit 2 ;;
+esac
 source "$root/bench/liggghts_pack.sh"
 csv="$root/bench/results/scaling.csv"
-echo "repeat,grains,threads,particle_steps_per_s,bytes_per_particle,peak_resident_bytes_per_particle,rebuild_over_step,neighbour_builds,contacts_per_grain_at_start,contacts_per_grain" > "$csv"
+echo "repeat,grains,threads,particle_steps_per_s,bytes_per_particle,peak_resident_bytes_per_particle,rebuild_over_step,neighbour_builds,contacts_per_grain_at_start,contacts_per_grain,bed_settled" > "$csv"
 for k in $(seq 1 "$repeats"); do
   for n in "${sizes[@]}"; do
     "$root/build/diefill" bench scaling --pack "runs/$tag.packed.dump" --sizes "$n" \
-      --threads 1 --threads 2 --steps "$steps" --cache "$root/out/bench" --json "$work/scaling_${k}_$n.json" 2>/dev/null
+      --threads 1 --threads 2 --steps "$steps" --cache "$root/out/bench" "${unsettled[@]}" --json "$work/scaling_${k}_$n.json" 2>/dev/null
     python3 - "$work/scaling_${k}_$n.json" "$k" >> "$csv" <<'PY'
 import json, sys
 for case in json.load(open(sys.argv[1]))["cases"]:
     for run in case["runs"]:
         print(f'{sys.argv[2]},{case["grains"]},{run["threads"]},{run["particle_steps_per_s"]},{run.get("bytes_per_particle", "")},'
               f'{run["peak_resident_bytes_per_particle"]},{run["rebuild_over_step"]},{run["neighbour_builds"]},'
-              f'{run["contacts_per_grain_at_start"]},{run["contacts_per_grain"]}')
+              f'{run["contacts_per_grain_at_start"]},{run["contacts_per_grain"]},{int(case["bed_settled"])}')
 PY
   done
 done
@@ -55,6 +63,7 @@ for t in (1, 2):
                       "neighbour_builds_max": max(int(r["neighbour_builds"]) for r in at),
                       "contacts_per_grain_at_start_median": statistics.median(float(r["contacts_per_grain_at_start"]) for r in at),
                       "contacts_per_grain_at_end_median": statistics.median(float(r["contacts_per_grain"]) for r in at),
+                      "bed_settled": all(r["bed_settled"] == "1" for r in at),
                       **({"bytes_per_particle": float(at[0]["bytes_per_particle"])} if at[0]["bytes_per_particle"] else {})})
     first = cases[0]["median"]
     # Each size's rate over the smallest size's, within each round (the host moves between rounds).
