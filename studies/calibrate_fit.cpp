@@ -27,28 +27,36 @@ const Vector2 prior_centre(0.5, 0.15), prior_width(0.3, 0.15);
 // The apparent density's repeatability (ASTM B212: about 1 %).
 constexpr double apparent_density_error = 0.01;
 
-double map_at(const ObservableFit& o, const Vector2& p) {
-  return o.coefficients[0] + o.coefficients[1] * p[0] + o.coefficients[2] * p[1] + o.coefficients[3] * p[0] * p[1];
+using Terms = Eigen::Matrix<double, ObservableFit::terms, 1>;
+
+// The map's terms at p: 1, μ, μ_r, μ μ_r, μ², μ_r².
+Terms terms_at(const Vector2& p) {
+  Terms x;
+  x << 1, p[0], p[1], p[0] * p[1], p[0] * p[0], p[1] * p[1];
+  return x;
 }
+
+double map_at(const ObservableFit& o, const Vector2& p) { return Eigen::Map<const Terms>(o.coefficients).dot(terms_at(p)); }
 Eigen::RowVector2d map_gradient(const ObservableFit& o, const Vector2& p) {
-  return {o.coefficients[1] + o.coefficients[3] * p[1], o.coefficients[2] + o.coefficients[3] * p[0]};
+  const double* b = o.coefficients;
+  return {b[1] + b[3] * p[1] + 2 * b[4] * p[0], b[2] + b[3] * p[0] + 2 * b[5] * p[1]};
 }
 
 void fit_map(ObservableFit& o, const std::vector<Finished>& tests, double TestResults::*member) {
-  Eigen::MatrixXd x(Eigen::Index(tests.size()), 4);
+  constexpr int n_terms = ObservableFit::terms;
+  Eigen::MatrixXd x(Eigen::Index(tests.size()), n_terms);
   Eigen::VectorXd y(Eigen::Index(tests.size()));
   for (std::size_t i = 0; i < tests.size(); ++i) {
-    const DesignPoint& p = tests[i].point;
-    x.row(Eigen::Index(i)) << 1, p.sliding, p.rolling, p.sliding * p.rolling;
+    x.row(Eigen::Index(i)) = terms_at(Vector2(tests[i].point.sliding, tests[i].point.rolling)).transpose();
     y[Eigen::Index(i)] = tests[i].results.*member;
   }
-  const Eigen::Vector4d b = x.colPivHouseholderQr().solve(y);
-  const Eigen::Matrix4d inverse = (x.transpose() * x).inverse();
-  for (int k = 0; k < 4; ++k) {
+  const Terms b = x.colPivHouseholderQr().solve(y);
+  const Eigen::Matrix<double, n_terms, n_terms> inverse = (x.transpose() * x).inverse();
+  for (int k = 0; k < n_terms; ++k) {
     o.coefficients[k] = b[k];
-    for (int l = 0; l < 4; ++l) o.design_inverse[k][l] = inverse(k, l);
+    for (int l = 0; l < n_terms; ++l) o.design_inverse[k][l] = inverse(k, l);
   }
-  const double dof = double(tests.size()) - 4;
+  const double dof = double(tests.size()) - n_terms;
   // Row by row: GCC 12 takes Eigen's freeing of the temporary x b - y for a use after free
   // (-Wuse-after-free, a false positive; warnings are errors).
   double squared = 0;
@@ -97,10 +105,10 @@ std::vector<ObservableFit> observables(const std::vector<Finished>& tests, const
 
 // The map's own variance at p: the tests' scatter through the design (falls with more seeds).
 double map_variance(const ObservableFit& o, const Vector2& p) {
-  const Eigen::Vector4d x(1, p[0], p[1], p[0] * p[1]);
+  const Terms x = terms_at(p);
   double v = 0;
-  for (int k = 0; k < 4; ++k)
-    for (int l = 0; l < 4; ++l) v += x[k] * o.design_inverse[k][l] * x[l];
+  for (int k = 0; k < ObservableFit::terms; ++k)
+    for (int l = 0; l < ObservableFit::terms; ++l) v += x[k] * o.design_inverse[k][l] * x[l];
   return o.scatter * o.scatter * v;
 }
 

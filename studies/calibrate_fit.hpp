@@ -19,16 +19,18 @@ struct Finished {
   TestResults results;
 };
 
-// One measured quantity against its map y = b0 + b1 μ + b2 μ_r + b3 μ μ_r over the design.
+// One measured quantity against its map over the design, a quadratic in the two frictions:
+// y = b0 + b1 μ + b2 μ_r + b3 μ μ_r + b4 μ² + b5 μ_r².
 struct ObservableFit {
   std::string name, unit;
   double measured = 0, measured_error = 0;  // the lab's value and its standard error
   bool used = true;
   std::string left_out;                     // why, when not used
   double model_error = 0;                   // of the simulated value as a stand-in for the lab's (standard error)
-  double coefficients[4] = {0, 0, 0, 0};
+  static constexpr int terms = 6;
+  double coefficients[terms] = {};
   double scatter = 0;                       // of the tests about the map (one test's noise)
-  double design_inverse[4][4] = {};         // (XᵀX)⁻¹ of the design: the map's own error at a point
+  double design_inverse[terms][terms] = {};  // (XᵀX)⁻¹ of the design: the map's own error at a point
   double fitted = 0;                        // the map at the calibrated frictions
   double residual = 0;                      // (fitted − measured) in combined standard errors
 };

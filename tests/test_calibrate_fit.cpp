@@ -4,7 +4,6 @@
 
 #include <cmath>
 #include <functional>
-#include <utility>
 #include <vector>
 
 #include "studies/calibrate.hpp"
@@ -19,13 +18,13 @@ struct ExactMaps {
   std::function<double(double, double)> repose_deg, beverloo_c, solid_fraction;
 };
 
-// The design's five points, each result exact (no scatter, so the maps carry no error of their
-// own), and the lab's file measured at (μ, μ_r) with a 1° angle.
+// calibrate's design, three levels of each friction, each result exact (no scatter, so the maps
+// carry no error of their own), and the lab's file measured at (μ, μ_r) with a 1° angle.
 std::vector<Finished> design(const ExactMaps& maps) {
   std::vector<Finished> tests;
-  const std::pair<double, double> points[] = {{0.2, 0.0}, {0.8, 0.0}, {0.2, 0.3}, {0.8, 0.3}, {0.5, 0.15}};
-  for (const auto& [mu, mu_r] : points)
-    tests.push_back({{mu, mu_r, 1}, TestResults{maps.repose_deg(mu, mu_r), maps.beverloo_c(mu, mu_r), maps.solid_fraction(mu, mu_r)}});
+  for (const double mu : {0.2, 0.5, 0.8})
+    for (const double mu_r : {0.0, 0.15, 0.3})
+      tests.push_back({{mu, mu_r, 1}, TestResults{maps.repose_deg(mu, mu_r), maps.beverloo_c(mu, mu_r), maps.solid_fraction(mu, mu_r)}});
   return tests;
 }
 
