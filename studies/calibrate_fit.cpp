@@ -171,15 +171,14 @@ CalibrationFit fit_frictions(const std::vector<Finished>& tests, const MeasuredP
   const Vector2 ci = 1.96 * with_prior.inverse().diagonal().cwiseSqrt();
   fit.sliding_ci = ci[0];
   fit.rolling_ci = ci[1];
-  // The measurements alone: a singular information leaves a friction unfixed.
-  const bool determined = std::abs(data.determinant()) > 1e-12 * std::max(1e-300, data.squaredNorm());
-  const Vector2 data_ci = determined ? Vector2(1.96 * data.inverse().diagonal().cwiseSqrt())
-                                     : Vector2::Constant(std::numeric_limits<double>::infinity());
+  // The measurements alone: where they leave a combination unfixed, neither friction is fixed.
+  std::tie(fit.best_fixed, fit.least_fixed) = fixed_combinations(data);
+  const Vector2 data_ci = std::isfinite(fit.least_fixed.ci) ? Vector2(1.96 * data.inverse().diagonal().cwiseSqrt())
+                                                            : Vector2::Constant(std::numeric_limits<double>::infinity());
   fit.sliding_data_ci = data_ci[0];
   fit.rolling_data_ci = data_ci[1];
   fit.sliding_pinned = data_ci[0] <= pinned_within;
   fit.rolling_pinned = data_ci[1] <= pinned_within;
-  std::tie(fit.best_fixed, fit.least_fixed) = fixed_combinations(data);
   const auto within = [&](double x, double DesignPoint::*along) {
     const auto [lo, hi] = std::minmax_element(tests.begin(), tests.end(),
                                               [&](const Finished& a, const Finished& b) { return a.point.*along < b.point.*along; });
@@ -205,14 +204,15 @@ std::string confidence_line(const char* name, double value, double ci, double da
 std::string combination_text(const FrictionCombination& c) {
   return fmt::format("{:.2f} μ {} {:.2f} μ_r", c.sliding, c.rolling < 0 ? "-" : "+", std::abs(c.rolling));
 }
-std::string half_width_text(double ci) { return std::isfinite(ci) ? fmt::format("± {:.3g}", ci) : "nothing"; }
+std::string fixed_text(const FrictionCombination& c) {
+  return std::isfinite(c.ci) ? fmt::format("fix {} to ± {:.3g}", combination_text(c), c.ci) : fmt::format("leave {} unfixed", combination_text(c));
+}
 
 std::string calibrated_toml(const MeasuredPowder& m, const CalibrationFit& fit) {
   std::string out = fmt::format("# diefill calibrate {}: the powder for a scene (docs/INTERFACE.md, \"Your powder\").\n", m.source);
   out += confidence_line("sliding_friction", fit.sliding, fit.sliding_ci, fit.sliding_data_ci, fit.sliding_pinned);
   out += confidence_line("rolling_friction", fit.rolling, fit.rolling_ci, fit.rolling_data_ci, fit.rolling_pinned);
-  out += fmt::format("# the measurements alone fix {} to {} and {} to {} (95 %)\n", combination_text(fit.best_fixed),
-                     half_width_text(fit.best_fixed.ci), combination_text(fit.least_fixed), half_width_text(fit.least_fixed.ci));
+  out += fmt::format("# the measurements alone {} and {} (95 %)\n", fixed_text(fit.best_fixed), fixed_text(fit.least_fixed));
   if (!fit.inside_design) out += "# outside the tested design (μ 0.2-0.8, μ_r 0-0.3): extrapolated by the maps\n";
   for (const ObservableFit& o : fit.observables)
     out += o.used ? fmt::format("# {}: measured {:.4g}, fitted {:.4g} ({:+.2f} standard errors)\n", o.name, o.measured, o.fitted, o.residual)
